@@ -1,0 +1,157 @@
+"""Contact terms in UFL and the multiplier space on the contact submesh.
+
+Sign conventions: the gap ``g >= 0`` when open; the multiplier ``lam <= 0``
+is the normal contact pressure (force per unit reference area); ``r > 0``
+(stress per length) is the penalty or augmentation parameter.
+
+Penalty (paper eq. 7):            r/2 min(g, 0)^2
+Alart-Curnier (paper eq. 9):      [min(lam + r g, 0)^2 - lam^2] / (2 r)
+Stationarity in lam gives the AC complementarity function
+lam = min(lam + r g, 0), which holds at the nodes with the vertex rule.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+import ufl
+from dolfinx import fem, mesh
+from mpi4py import MPI
+
+from fenics_contact.petsc_vectors import assemble_local
+
+Quadrature = Literal["nodal", "gauss"]
+
+#: Tag given to candidate contact facets in the facet tags of ``ds``.
+CONTACT_TAG = 1
+
+
+def penalty_energy(g: ufl.core.expr.Expr, r: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+    """Penalty energy density r/2 min(g, 0)^2 (energy per reference area)."""
+    return 0.5 * r * ufl.min_value(g, 0) ** 2
+
+
+def augmented_lagrangian_energy(
+    g: ufl.core.expr.Expr, lam: ufl.core.expr.Expr, r: ufl.core.expr.Expr
+) -> ufl.core.expr.Expr:
+    """Alart-Curnier augmented Lagrangian density [min(lam + r g, 0)^2 - lam^2] / (2 r)."""
+    return (ufl.min_value(lam + r * g, 0) ** 2 - lam**2) / (2 * r)
+
+
+def augmented_pressure(
+    g: ufl.core.expr.Expr, lam: ufl.core.expr.Expr, r: ufl.core.expr.Expr
+) -> ufl.core.expr.Expr:
+    """The pressure the AL term transmits, min(lam + r g, 0) (<= 0)."""
+    return ufl.min_value(lam + r * g, 0)
+
+
+@dataclass(frozen=True)
+class ContactSettings:
+    """How contact is regularised and integrated.
+
+    Attributes:
+        r: penalty/augmentation parameter. Relative to E/h (h the mean contact
+            facet size) when ``relative`` is true, absolute (stress/length)
+            otherwise, as in the paper's tables (E = 210).
+        relative: see ``r``.
+        quadrature: 'nodal' puts the quadrature points at the facet vertices
+            (the paper's node-on-facet, lumped multiplier mass, exact nodal
+            complementarity); 'gauss' integrates the term exactly-ish.
+    """
+
+    r: float = 1.0
+    relative: bool = True
+    quadrature: Quadrature = "nodal"
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.r) and self.r > 0):
+            raise ValueError(
+                f"The contact parameter r must be finite and > 0, got r = {self.r}; "
+                "typical values are 1 to 1e4 relative to E/h."
+            )
+        if self.quadrature not in ("nodal", "gauss"):
+            raise ValueError(
+                f"Contact quadrature {self.quadrature!r} is unknown; use 'nodal' or 'gauss'."
+            )
+
+
+def vertex_measure(
+    domain: mesh.Mesh, tags: mesh.MeshTags, quadrature: Quadrature = "nodal"
+) -> ufl.Measure:
+    """Surface measure over the contact facets, with the vertex rule for 'nodal'."""
+    metadata = (
+        {"quadrature_rule": "vertex", "quadrature_degree": 1}
+        if quadrature == "nodal"
+        else {"quadrature_degree": 4}
+    )
+    return ufl.Measure(
+        "ds", domain=domain, subdomain_data=tags, subdomain_id=CONTACT_TAG, metadata=metadata
+    )
+
+
+def facet_diameters(domain: mesh.Mesh, facets: np.ndarray) -> np.ndarray:
+    """Largest vertex-to-vertex distance of each facet (length units)."""
+    fdim = domain.topology.dim - 1
+    nodes = mesh.entities_to_geometry(domain, fdim, facets)
+    coords = domain.geometry.x[nodes]  # (n_facets, n_nodes, 3)
+    diffs = coords[:, :, None, :] - coords[:, None, :, :]
+    return np.linalg.norm(diffs, axis=-1).max(axis=(1, 2))
+
+
+class ContactSurface:
+    """Candidate contact facets, their submesh and the P1 multiplier space on it.
+
+    Only the facets given here carry multiplier degrees of freedom.
+    """
+
+    def __init__(
+        self, domain: mesh.Mesh, facets: np.ndarray, quadrature: Quadrature = "nodal"
+    ) -> None:
+        fdim = domain.topology.dim - 1
+        domain.topology.create_connectivity(fdim, domain.topology.dim)
+        facets = np.unique(np.asarray(facets, dtype=np.int32))
+        n_global = domain.comm.allreduce(facets.size, op=MPI.SUM)
+        if n_global == 0:
+            raise ValueError(
+                "No candidate contact facets: check the contact tag or the obstacle "
+                "detection margin."
+            )
+        self.domain = domain
+        self.facets = facets
+        self.quadrature = quadrature
+        self.tags = mesh.meshtags(
+            domain, fdim, facets, np.full(facets.size, CONTACT_TAG, dtype=np.int32)
+        )
+        self.submesh, self.entity_map, _, _ = mesh.create_submesh(domain, fdim, facets)
+        self.Q = fem.functionspace(self.submesh, ("Lagrange", 1))
+        self.ds = vertex_measure(domain, self.tags, quadrature)
+        self.ds_nodal = vertex_measure(domain, self.tags, "nodal")
+        self.entity_maps = [self.entity_map]
+        size = domain.comm.allreduce(float(np.sum(facet_diameters(domain, facets))), op=MPI.SUM)
+        #: Mean size of the candidate contact facets (length units).
+        self.h = size / n_global
+        mu = ufl.TestFunction(self.Q)
+        self._mu = mu
+        self.lumped_area = assemble_local(
+            fem.form(mu * self.ds_nodal, entity_maps=self.entity_maps)
+        )
+
+    @property
+    def num_dofs(self) -> int:
+        """Global number of multiplier degrees of freedom."""
+        im = self.Q.dofmap.index_map
+        return im.size_global * self.Q.dofmap.index_map_bs
+
+    def nodal_form(self, expr: ufl.core.expr.Expr) -> fem.Form:
+        """Compile the form that gives nodal values of ``expr`` (see :meth:`nodal`)."""
+        return fem.form(expr * self._mu * self.ds_nodal, entity_maps=self.entity_maps)
+
+    def nodal(self, compiled: fem.Form) -> np.ndarray:
+        """Values at the owned multiplier nodes of an expression compiled by :meth:`nodal_form`.
+
+        The vertex rule makes the assembled vector the lumped area times the
+        nodal value; dividing by the lumped area returns the value.
+        """
+        return assemble_local(compiled) / self.lumped_area

@@ -1,0 +1,148 @@
+"""Convergence statuses, iteration histories and the Signorini (KKT) check.
+
+Statuses, with their defined tests (checked in this order each iteration):
+
+- ``diverged``: the residual is NaN/inf, a linear solve failed, or the
+  residual exceeds ``divergence_factor`` times the first residual of the solve.
+- ``converged``: the residual norm is at most ``max(atol, rtol * first)``.
+- ``cycling``: over the last ``cycle_window`` iterations the residual never
+  fell below the smallest value seen before that window, and the active set
+  (or, without one, the rounded residual) returned to a state it had left
+  within the window (a pattern A -> B -> A).
+- ``max_iterations``: the iteration limit was reached (the paper's "> 500").
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Hashable
+from dataclasses import dataclass, field
+from enum import StrEnum
+
+import numpy as np
+
+
+class Status(StrEnum):
+    """Outcome of one nonlinear solve."""
+
+    CONVERGED = "converged"
+    CYCLING = "cycling"
+    DIVERGED = "diverged"
+    MAX_ITERATIONS = "max_iterations"
+
+
+@dataclass(frozen=True)
+class SolverSettings:
+    """Stopping rules shared by every strategy.
+
+    Attributes:
+        atol: absolute tolerance on the L2 norm of the static residual (force).
+        rtol: tolerance relative to the first residual of the solve (0 disables).
+        max_iterations: Newton iterations allowed in one solve (one load step).
+        divergence_factor: residual growth over the first residual that means divergence.
+        cycle_window: iterations inspected by the cycling test.
+    """
+
+    atol: float = 1e-8
+    rtol: float = 0.0
+    max_iterations: int = 50
+    divergence_factor: float = 1e6
+    cycle_window: int = 12
+
+    def __post_init__(self) -> None:
+        if not (self.atol >= 0 and self.rtol >= 0 and (self.atol > 0 or self.rtol > 0)):
+            raise ValueError(
+                f"Tolerances must be >= 0 and not both zero (atol={self.atol}, rtol={self.rtol})."
+            )
+        if self.max_iterations < 1:
+            raise ValueError(f"max_iterations must be >= 1, got {self.max_iterations}.")
+
+
+@dataclass
+class ConvergenceMonitor:
+    """Records residuals and active sets of one solve and decides its status."""
+
+    settings: SolverSettings
+    residuals: list[float] = field(default_factory=list)
+    states: list[Hashable] = field(default_factory=list)
+    status: Status | None = None
+
+    iterations: int = 0
+
+    def tolerance(self) -> float:
+        """The residual level that counts as converged."""
+        first = self.residuals[0] if self.residuals else math.inf
+        return max(self.settings.atol, self.settings.rtol * first)
+
+    def check(
+        self, residual: float, state: Hashable | None = None, iterations: int | None = None
+    ) -> Status | None:
+        """Record one residual and active-set state; return a final status or None.
+
+        ``iterations`` is the number of Newton steps taken so far (by default
+        the number of residuals recorded before this one).
+        """
+        self.iterations = len(self.residuals) if iterations is None else iterations
+        self.residuals.append(float(residual))
+        self.states.append(state if state is not None else round(math.log10(residual + 1e-300), 3)
+                           if math.isfinite(residual) else None)
+        s = self.settings
+        if not math.isfinite(residual):
+            self.status = Status.DIVERGED
+        elif residual <= self.tolerance():
+            self.status = Status.CONVERGED
+        elif residual > s.divergence_factor * max(self.residuals[0], s.atol):
+            self.status = Status.DIVERGED
+        elif self._cycling():
+            self.status = Status.CYCLING
+        elif self.iterations >= s.max_iterations:
+            self.status = Status.MAX_ITERATIONS
+        return self.status
+
+    def fail(self) -> Status:
+        """Mark the solve diverged (a linear solve failed)."""
+        self.status = Status.DIVERGED
+        return self.status
+
+    def _cycling(self) -> bool:
+        w = self.settings.cycle_window
+        if len(self.residuals) <= w + 1:
+            return False
+        before = min(self.residuals[:-w])
+        window = self.residuals[-w:]
+        if min(window) < before:
+            return False
+        states = self.states[-w:]
+        for i in range(len(states) - 2):
+            for j in range(i + 2, len(states)):
+                if states[j] == states[i] and any(states[k] != states[i] for k in range(i + 1, j)):
+                    return True
+        return False
+
+
+@dataclass(frozen=True)
+class SignoriniReport:
+    """Worst violations of the nodal Signorini conditions.
+
+    Attributes:
+        min_gap: most negative nodal gap (penetration), length.
+        max_pressure: largest nodal pressure (should be <= 0), stress.
+        max_complementarity: max |lam g| (stress * length).
+    """
+
+    min_gap: float
+    max_pressure: float
+    max_complementarity: float
+
+
+def signorini_report(gap: np.ndarray, pressure: np.ndarray, comm) -> SignoriniReport:  # noqa: ANN001
+    """Global worst violations of g >= 0, lam <= 0, lam g = 0 at the nodes."""
+    from mpi4py import MPI
+
+    return SignoriniReport(
+        min_gap=comm.allreduce(float(np.min(gap, initial=np.inf)), op=MPI.MIN),
+        max_pressure=comm.allreduce(float(np.max(pressure, initial=-np.inf)), op=MPI.MAX),
+        max_complementarity=comm.allreduce(
+            float(np.max(np.abs(gap * pressure), initial=0.0)), op=MPI.MAX
+        ),
+    )

@@ -1,0 +1,127 @@
+"""Strain energy densities written in UFL.
+
+Every law maps the displacement ``u`` to a strain energy per unit reference
+volume (stress units, e.g. the paper's E = 210). In 2D the body is in plane
+strain: the out-of-plane stretch is one. Stresses and tangents are never
+written by hand: the residual is ``ufl.derivative`` of the stored energy.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import ufl
+
+
+@dataclass(frozen=True)
+class Elastic:
+    """Isotropic elastic constants shared by every law.
+
+    Attributes:
+        E: Young's modulus (stress units).
+        nu: Poisson's ratio, -1 < nu < 0.5.
+    """
+
+    E: float
+    nu: float
+
+    def __post_init__(self) -> None:
+        if not self.E > 0:
+            raise ValueError(f"Young's modulus E must be > 0, got E = {self.E}.")
+        if not -1.0 < self.nu < 0.5:
+            raise ValueError(
+                f"Poisson's ratio nu must lie in (-1, 0.5), got nu = {self.nu}; "
+                "use nu < 0.5 (for example 0.4999) for near-incompressibility."
+            )
+
+    @property
+    def mu(self) -> float:
+        """Shear modulus."""
+        return self.E / (2.0 * (1.0 + self.nu))
+
+    @property
+    def lmbda(self) -> float:
+        """First Lame parameter (3D value; plane strain uses it as it is)."""
+        return self.E * self.nu / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
+
+    @property
+    def plane_strain_modulus(self) -> float:
+        """E* = E / (1 - nu^2), the modulus of Hertz theory against a rigid body."""
+        return self.E / (1.0 - self.nu**2)
+
+    #: Whether the law is geometrically nonlinear (finite strain).
+    finite_strain: bool = True
+
+    def strain_energy(self, u: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+        """Stored energy density psi(u) per unit reference volume."""
+        raise NotImplementedError
+
+
+def deformation_gradient(u: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+    """F = I + grad u (reference gradient)."""
+    d = len(u)
+    return ufl.Identity(d) + ufl.grad(u)
+
+
+@dataclass(frozen=True)
+class SaintVenantKirchhoff(Elastic):
+    """psi = lmbda/2 (tr E)^2 + mu E:E with the Green-Lagrange strain E (the paper's law)."""
+
+    def strain_energy(self, u: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+        """Stored energy density."""
+        F = deformation_gradient(u)
+        Egl = 0.5 * (F.T * F - ufl.Identity(len(u)))
+        return 0.5 * self.lmbda * ufl.tr(Egl) ** 2 + self.mu * ufl.inner(Egl, Egl)
+
+
+@dataclass(frozen=True)
+class NeoHookean(Elastic):
+    """Compressible neo-Hookean: psi = mu/2 (I1 - 3) - mu ln J + lmbda/2 (ln J)^2.
+
+    In plane strain I1 = tr(C) + 1 (the out-of-plane stretch is one).
+    """
+
+    def strain_energy(self, u: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+        """Stored energy density."""
+        d = len(u)
+        F = deformation_gradient(u)
+        J = ufl.det(F)
+        I1 = ufl.tr(F.T * F) + (3 - d)
+        lnJ = ufl.ln(J)
+        return 0.5 * self.mu * (I1 - 3) - self.mu * lnJ + 0.5 * self.lmbda * lnJ**2
+
+
+@dataclass(frozen=True)
+class LinearElastic(Elastic):
+    """Small-strain linear elasticity: psi = lmbda/2 (tr eps)^2 + mu eps:eps.
+
+    Used for validation against Hertz theory. The contact gap is still
+    evaluated at x = X + u (exact for the small loads of those checks).
+    """
+
+    finite_strain: bool = False
+
+    def strain_energy(self, u: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+        """Stored energy density."""
+        eps = ufl.sym(ufl.grad(u))
+        return 0.5 * self.lmbda * ufl.tr(eps) ** 2 + self.mu * ufl.inner(eps, eps)
+
+
+MATERIALS: dict[str, type[Elastic]] = {
+    "svk": SaintVenantKirchhoff,
+    "saint-venant-kirchhoff": SaintVenantKirchhoff,
+    "neo-hookean": NeoHookean,
+    "neohookean": NeoHookean,
+    "linear": LinearElastic,
+}
+
+
+def material(name: str, E: float, nu: float) -> Elastic:
+    """Build a law by name ('svk', 'neo-hookean' or 'linear')."""
+    try:
+        cls = MATERIALS[name.lower()]
+    except KeyError:
+        raise ValueError(
+            f"Unknown material law {name!r}; choose one of 'svk', 'neo-hookean', 'linear'."
+        ) from None
+    return cls(E=E, nu=nu)

@@ -1,0 +1,294 @@
+"""A hyperelastic body against a rigid obstacle: unknowns, loads and UFL forms.
+
+The problem owns the displacement ``u`` (vector P-k on the body), the
+multiplier ``lam`` (P1 on the contact submesh), the load factor and the
+parameter ``r``; it hands solvers :class:`VariationalSystem` objects (UFL
+residual blocks with their unknowns) and never imports a solver itself.
+All loads are proportional to one load factor ``t`` in [0, 1].
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import ufl
+from dolfinx import default_scalar_type, fem, mesh
+from mpi4py import MPI
+
+from fenics_contact.contact import (
+    ContactSettings,
+    ContactSurface,
+    augmented_lagrangian_energy,
+    augmented_pressure,
+    penalty_energy,
+)
+from fenics_contact.materials import Elastic
+from fenics_contact.obstacles import RigidObstacle
+
+
+@dataclass(frozen=True)
+class PrescribedDisplacement:
+    """Displacement imposed on facets, proportional to the load factor.
+
+    Attributes:
+        facets: facet indices (local) where the condition holds.
+        value: final displacement per component (length units); ``None``
+            leaves that component free.
+    """
+
+    facets: np.ndarray
+    value: tuple[float | None, ...]
+
+
+@dataclass(frozen=True)
+class SurfaceTraction:
+    """Traction on facets per unit reference area, proportional to the load factor."""
+
+    facets: np.ndarray
+    value: tuple[float, ...]
+
+
+@dataclass
+class VariationalSystem:
+    """Residual blocks F_i(unknowns; tests) = 0 and what a solver needs to compile them."""
+
+    name: str
+    residuals: list[ufl.Form]
+    unknowns: list[fem.Function]
+    bcs: list[fem.DirichletBC]
+    entity_maps: list = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class ContactState:
+    """Nodal contact diagnostics at the current iterate.
+
+    Attributes:
+        gap: nodal gaps at the owned multiplier nodes (length).
+        pressure: transmitted nodal pressure min(lam + r g, 0) (<= 0, stress).
+        multiplier: nodal multiplier lam.
+        active_count: global number of nodes with lam + r g < 0.
+        max_penetration: global max of -min(g, 0) (length).
+        contact_force: global normal force -int p dA on the reference surface
+            (force; per unit thickness in 2D).
+    """
+
+    gap: np.ndarray
+    pressure: np.ndarray
+    multiplier: np.ndarray
+    active: np.ndarray
+    active_count: int
+    max_penetration: float
+    contact_force: float
+
+
+class ContactProblem:
+    """One deformable body, one rigid obstacle, proportional loading."""
+
+    def __init__(
+        self,
+        domain: mesh.Mesh,
+        material: Elastic,
+        obstacle: RigidObstacle,
+        contact_facets: np.ndarray,
+        settings: ContactSettings,
+        *,
+        prescribed: Sequence[PrescribedDisplacement] = (),
+        tractions: Sequence[SurfaceTraction] = (),
+        obstacle_motion: Sequence[float] | None = None,
+        degree: int = 1,
+    ) -> None:
+        gdim = domain.geometry.dim
+        if domain.topology.dim != gdim:
+            raise ValueError(
+                f"The body mesh is {domain.topology.dim}D in {gdim}D space; "
+                "use a mesh whose topological and geometric dimensions agree."
+            )
+        self.domain = domain
+        self.comm = domain.comm
+        self.material = material
+        self.obstacle = obstacle
+        self.settings = settings
+        self.V = fem.functionspace(domain, ("Lagrange", degree, (gdim,)))
+        self.u = fem.Function(self.V, name="displacement")
+        self.surface = ContactSurface(domain, contact_facets, settings.quadrature)
+        self.Q = self.surface.Q
+        self.lam = fem.Function(self.Q, name="contact_pressure")
+        self.r = fem.Constant(domain, default_scalar_type(1.0))
+        self.set_r(settings.r, relative=settings.relative)
+        self.load_factor = 0.0
+
+        self._motion = (
+            np.zeros(gdim) if obstacle_motion is None else np.asarray(obstacle_motion, float)
+        )
+        self._bc_constants: list[tuple[fem.Constant, float]] = []
+        self.bcs = self._dirichlet(prescribed)
+        self._traction_constants: list[tuple[fem.Constant, np.ndarray]] = []
+        external = self._external_work(tractions)
+
+        x = ufl.SpatialCoordinate(domain) + self.u
+        self.gap = obstacle.gap(x)
+        self.pressure = augmented_pressure(self.gap, self.lam, self.r)
+        self.potential = material.strain_energy(self.u) * ufl.dx
+        if external is not None:
+            self.potential -= external
+
+        self._gap_form = self.surface.nodal_form(self.gap)
+        self._pressure_form = self.surface.nodal_form(self.pressure)
+        self._force_form = fem.form(
+            -self.pressure * self.surface.ds, entity_maps=self.surface.entity_maps
+        )
+
+    # -- parameters and loads -------------------------------------------------
+    @property
+    def stiffness_scale(self) -> float:
+        """E/h: the scale that makes r dimensionless (stress per length)."""
+        return self.material.E / self.surface.h
+
+    def set_r(self, r: float, *, relative: bool) -> None:
+        """Set the penalty/augmentation parameter, relative to E/h or absolute."""
+        if not (np.isfinite(r) and r > 0):
+            raise ValueError(f"r must be finite and > 0, got {r}.")
+        self.r.value = r * self.stiffness_scale if relative else r
+
+    @property
+    def r_absolute(self) -> float:
+        """r in stress per length."""
+        return float(self.r.value)
+
+    @property
+    def r_relative(self) -> float:
+        """r divided by E/h."""
+        return self.r_absolute / self.stiffness_scale
+
+    def set_load(self, t: float) -> None:
+        """Apply the load factor t: prescribed values, tractions and obstacle motion."""
+        self.load_factor = float(t)
+        for const, value in self._bc_constants:
+            const.value = t * value
+        for const, value in self._traction_constants:
+            const.value[:] = t * value
+        self.obstacle.translate_to(t * self._motion)
+
+    def _dirichlet(self, prescribed: Sequence[PrescribedDisplacement]) -> list[fem.DirichletBC]:
+        fdim = self.domain.topology.dim - 1
+        bcs = []
+        for condition in prescribed:
+            if len(condition.value) != self.domain.geometry.dim:
+                raise ValueError(
+                    f"Prescribed displacement {condition.value} needs one entry per "
+                    f"component ({self.domain.geometry.dim}); use None for a free one."
+                )
+            for i, value in enumerate(condition.value):
+                if value is None:
+                    continue
+                Vi = self.V.sub(i)
+                dofs = fem.locate_dofs_topological(Vi, fdim, condition.facets)
+                const = fem.Constant(self.domain, default_scalar_type(0.0))
+                self._bc_constants.append((const, float(value)))
+                bcs.append(fem.dirichletbc(const, dofs, Vi))
+        return bcs
+
+    def _external_work(self, tractions: Sequence[SurfaceTraction]) -> ufl.Form | None:
+        fdim = self.domain.topology.dim - 1
+        if not tractions:
+            return None
+        facets = np.concatenate([np.asarray(t.facets, np.int32) for t in tractions])
+        values = np.concatenate(
+            [np.full(len(t.facets), i + 1, np.int32) for i, t in enumerate(tractions)]
+        )
+        order = np.argsort(facets)
+        tags = mesh.meshtags(self.domain, fdim, facets[order], values[order])
+        ds = ufl.Measure("ds", domain=self.domain, subdomain_data=tags)
+        work = 0
+        for i, traction in enumerate(tractions):
+            const = fem.Constant(self.domain, np.zeros(self.domain.geometry.dim))
+            self._traction_constants.append((const, np.asarray(traction.value, float)))
+            work += ufl.dot(const, self.u) * ds(i + 1)
+        return work
+
+    # -- systems handed to solvers -------------------------------------------
+    def augmented_system(self) -> VariationalSystem:
+        """Alart-Curnier saddle point on (u, lam): the GNRM system.
+
+        The multiplier block is r dL/dlam = (min(lam + r g, 0) - lam) mu,
+        the complementarity residual in force units.
+        """
+        v = ufl.TestFunction(self.V)
+        mu = ufl.TestFunction(self.Q)
+        lagrangian = self.potential + augmented_lagrangian_energy(
+            self.gap, self.lam, self.r
+        ) * self.surface.ds
+        residual_u = ufl.derivative(lagrangian, self.u, v)
+        residual_lam = self.r * ufl.derivative(lagrangian, self.lam, mu)
+        return VariationalSystem(
+            "augmented", [residual_u, residual_lam], [self.u, self.lam], self.bcs,
+            self.surface.entity_maps,
+        )
+
+    def primal_system(self) -> VariationalSystem:
+        """Equilibrium in u with lam held fixed (the Uzawa inner problem)."""
+        v = ufl.TestFunction(self.V)
+        lagrangian = self.potential + augmented_lagrangian_energy(
+            self.gap, self.lam, self.r
+        ) * self.surface.ds
+        return VariationalSystem(
+            "primal", [ufl.derivative(lagrangian, self.u, v)], [self.u], self.bcs,
+            self.surface.entity_maps,
+        )
+
+    def penalty_system(self) -> VariationalSystem:
+        """Penalty regularisation (paper eq. 7) in u only."""
+        v = ufl.TestFunction(self.V)
+        energy = self.potential + penalty_energy(self.gap, self.r) * self.surface.ds
+        return VariationalSystem(
+            "penalty", [ufl.derivative(energy, self.u, v)], [self.u], self.bcs,
+            self.surface.entity_maps,
+        )
+
+    def complementarity_residual(self) -> ufl.Form:
+        """(min(lam + r g, 0) - lam) mu: zero when lam is the converged pressure."""
+        mu = ufl.TestFunction(self.Q)
+        return (self.pressure - self.lam) * mu * self.surface.ds
+
+    # -- diagnostics -----------------------------------------------------------
+    def contact_state(self) -> ContactState:
+        """Nodal gaps, pressures, the active set and global summaries."""
+        gap = self.surface.nodal(self._gap_form)
+        pressure = self.surface.nodal(self._pressure_form)
+        n_owned = gap.size
+        multiplier = self.lam.x.array[:n_owned].copy()
+        active = pressure < 0.0
+        comm = self.comm
+        return ContactState(
+            gap=gap,
+            pressure=pressure,
+            multiplier=multiplier,
+            active=active,
+            active_count=comm.allreduce(int(active.sum()), op=MPI.SUM),
+            max_penetration=comm.allreduce(
+                float(np.max(-np.minimum(gap, 0.0), initial=0.0)), op=MPI.MAX
+            ),
+            contact_force=comm.allreduce(
+                fem.assemble_scalar(self._force_form), op=MPI.SUM
+            ),
+        )
+
+    def active_signature(self) -> tuple[bytes, ...]:
+        """A hashable fingerprint of the global active set (lam + r g < 0 at the nodes)."""
+        active = self.surface.nodal(self._pressure_form) < 0.0
+        return tuple(self.comm.allgather(np.packbits(active).tobytes()))
+
+    def update_multiplier(self) -> None:
+        """Uzawa update lam <- min(lam + r g, 0) at the nodes (paper eq. 10)."""
+        pressure = self.surface.nodal(self._pressure_form)
+        self.lam.x.array[: pressure.size] = pressure
+        self.lam.x.scatter_forward()
+
+    def nodal_coordinates(self) -> np.ndarray:
+        """Reference coordinates of the owned multiplier nodes, shape (n, 3)."""
+        n = self.Q.dofmap.index_map.size_local
+        return self.Q.tabulate_dof_coordinates()[:n]
+

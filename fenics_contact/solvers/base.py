@@ -1,0 +1,113 @@
+"""What a strategy returns and the shared Newton loop."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Protocol
+
+from fenics_contact.diagnostics import ConvergenceMonitor, SolverSettings, Status
+from fenics_contact.problem import ContactProblem, VariationalSystem
+from fenics_contact.solvers.newton import NewtonKernel
+
+
+@dataclass
+class SolveResult:
+    """Outcome of one nonlinear solve (one load increment).
+
+    Attributes:
+        status: see :class:`fenics_contact.diagnostics.Status`.
+        iterations: Newton iterations (each one linear solve).
+        updates: multiplier updates (Uzawa strategies; 0 otherwise).
+        linear_solves: linear systems solved.
+        residuals: static residual norm at every check.
+        wall_s: wall-clock time of the solve (seconds).
+        switches: decisions an adaptive strategy took, in order.
+    """
+
+    status: Status
+    iterations: int
+    updates: int
+    linear_solves: int
+    residuals: list[float]
+    wall_s: float = 0.0
+    switches: list[str] = field(default_factory=list)
+
+    @property
+    def converged(self) -> bool:
+        """True when the status is converged."""
+        return self.status is Status.CONVERGED
+
+
+class Strategy(Protocol):
+    """A solution strategy bound to one problem."""
+
+    name: str
+    problem: ContactProblem
+    settings: SolverSettings
+
+    def solve(self) -> SolveResult:
+        """Solve at the problem's current load, starting from its current state."""
+        ...
+
+
+def newton_loop(
+    kernel: NewtonKernel,
+    monitor: ConvergenceMonitor,
+    residual_norm: Callable[[], float],
+    state: Callable[[], object],
+    after_step: Callable[[], None] | None = None,
+) -> tuple[Status, int]:
+    """Newton iterations until the monitor gives a status.
+
+    ``residual_norm`` assembles the residual the step needs and returns the
+    norm used for the stopping test; ``after_step`` runs after each step
+    (the simultaneous Uzawa update). Returns the status and the step count.
+    """
+    steps = 0
+    while True:
+        norm = residual_norm()
+        status = monitor.check(norm, state(), iterations=steps)
+        if status is not None:
+            return status, steps
+        if not kernel.newton_step():
+            return monitor.fail(), steps
+        steps += 1
+        if after_step is not None:
+            after_step()
+
+
+def timed(fn: Callable[[], SolveResult]) -> SolveResult:
+    """Run a solve and store its wall time in the result."""
+    start = time.perf_counter()
+    result = fn()
+    result.wall_s = time.perf_counter() - start
+    return result
+
+
+class MonolithicNewton:
+    """Plain Newton on one system built by :meth:`build_system` (GNRM and PM)."""
+
+    name = "newton"
+
+    def __init__(self, problem: ContactProblem, settings: SolverSettings) -> None:
+        self.problem = problem
+        self.settings = settings
+        self.kernel = NewtonKernel(self.build_system(problem))
+
+    def build_system(self, problem: ContactProblem) -> VariationalSystem:
+        """The residual blocks this strategy solves."""
+        raise NotImplementedError
+
+    def solve(self) -> SolveResult:
+        """Newton until the system's residual norm passes the stopping test."""
+        return timed(self._solve)
+
+    def _solve(self) -> SolveResult:
+        monitor = ConvergenceMonitor(self.settings)
+        before = self.kernel.linear_solves
+        status, steps = newton_loop(
+            self.kernel, monitor, self.kernel.assemble_residual, self.problem.active_signature
+        )
+        return SolveResult(status, steps, 0, self.kernel.linear_solves - before, monitor.residuals)
