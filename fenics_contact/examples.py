@@ -48,6 +48,7 @@ class BarOnCradle:
     radius: float = 10.0
     end_gap: float = 0.02
     push: float = 0.8
+    steps: int = 10
 
     def cradle_centre(self) -> tuple[float, float]:
         """Centre of the cradle circle: its arc passes end_gap below the bar's corners."""
@@ -83,3 +84,9 @@ class BarOnCradle:
             settings,
             prescribed=[PrescribedDisplacement(punch, (0.0, -self.push))],
         )
+
+
+#: Examples the ``study`` command knows, by name.
+EXAMPLES: dict[str, type] = {
+    "paper-ex2": BarOnCradle,
+}

@@ -269,7 +269,7 @@ class ContactProblem:
             active=active,
             active_count=comm.allreduce(int(active.sum()), op=MPI.SUM),
             max_penetration=comm.allreduce(
-                float(np.max(-np.minimum(gap, 0.0), initial=0.0)), op=MPI.MAX
+                float(np.max(-np.minimum(gap, 0.0), initial=0.0)) + 0.0, op=MPI.MAX
             ),
             contact_force=comm.allreduce(
                 fem.assemble_scalar(self._force_form), op=MPI.SUM

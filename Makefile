@@ -1,0 +1,35 @@
+# Set-up, main job and tests. `make demo` and `make test` work on a fresh
+# machine: they create .venv with a Python >= 3.12 and install the package.
+VENV    ?= .venv
+PYTHON  ?= $(shell scripts/find-python)
+EXTRAS  ?= dolfinx,mesh,viz,test
+BIN     := $(VENV)/bin
+MPIEXEC ?= $(shell [ -x $(BIN)/mpiexec ] && echo $(BIN)/mpiexec || echo mpiexec)
+OUT     ?= results
+
+.PHONY: demo test test-serial test-mpi venv clean
+
+venv: $(VENV)/.installed
+
+$(VENV)/.installed: pyproject.toml
+	@test -n "$(PYTHON)" || { echo "error: no Python >= 3.12 found (see above)"; exit 1; }
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e ".[$(EXTRAS)]"
+	@touch $@
+
+# The main job: the paper's Example 2 analog with GNRM for r = 1 ... 10000.
+demo: venv
+	$(BIN)/python demos/paper_example2.py --out $(OUT)/paper-ex2
+
+test: test-serial test-mpi
+
+test-serial: venv
+	$(BIN)/python -m pytest -q
+
+# Tests marked `mpi` again on two processes.
+test-mpi: venv
+	$(MPIEXEC) -n 2 $(BIN)/python -m pytest -q -m mpi -p no:cacheprovider
+
+clean:
+	rm -rf $(VENV) $(OUT) .pytest_cache

@@ -1,0 +1,125 @@
+"""The ``fenics-contact`` command."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+import fenics_contact  # noqa: F401  (imports the DOLFINx wheel first)
+
+
+def _floats(text: str) -> list[float]:
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected a comma-separated list of numbers such as 1,10,100, got {text!r}"
+        ) from None
+    if not values or any(not v > 0 for v in values):
+        raise argparse.ArgumentTypeError(f"every r must be > 0, got {text!r}")
+    return values
+
+
+def _methods(text: str) -> list[str]:
+    from fenics_contact.solvers import STRATEGIES
+
+    names = [m.strip().lower() for m in text.split(",") if m.strip()]
+    unknown = [m for m in names if m not in STRATEGIES]
+    if unknown or not names:
+        raise argparse.ArgumentTypeError(
+            f"unknown method(s) {unknown or text!r}; choose from {','.join(STRATEGIES)}"
+        )
+    return names
+
+
+def _study(args: argparse.Namespace) -> int:
+    from fenics_contact.diagnostics import SolverSettings
+    from fenics_contact.examples import EXAMPLES
+    from fenics_contact.io import write_csv, write_json
+    from fenics_contact.plotting import iterations_against_r, residual_histories
+    from fenics_contact.study import paper_table, run_study
+
+    example = EXAMPLES[args.example]()
+    out: Path = args.out
+    settings = SolverSettings(atol=args.tol, max_iterations=args.max_iterations)
+
+    def show(rec) -> None:  # noqa: ANN001
+        print(
+            f"  {rec.method:8s} r = {rec.r:<10g} {rec.status:15s} iterations {rec.iterations:4d}"
+            f"  updates {rec.updates:4d}  {rec.wall_s:6.2f} s",
+            flush=True,
+        )
+
+    print(f"Study {args.example}: methods {','.join(args.methods)}; r = {args.r}", flush=True)
+    records = run_study(
+        example, args.methods, args.r, relative=args.relative, settings=settings,
+        quadrature=args.quadrature, progress=show,
+    )
+    table = paper_table(records, limit=args.max_iterations)
+    print()
+    print(table)
+    write_json(out / "study.json", [r.__dict__ for r in records])
+    write_csv(out / "study.csv", [r.row() for r in records])
+    (out / "table.md").write_text(table + "\n")
+    residual_histories(records, out / "residuals.png")
+    iterations_against_r(records, out / "iterations.png")
+    print(f"\nWrote {out}/study.json, study.csv, table.md, residuals.png, iterations.png")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser with every subcommand."""
+    from fenics_contact.examples import EXAMPLES
+
+    parser = argparse.ArgumentParser(
+        prog="fenics-contact",
+        description="Finite-deformation contact with the Alart-Curnier augmented Lagrangian.",
+    )
+    sub = parser.add_subparsers(dest="command", required=True)
+    study = sub.add_parser(
+        "study",
+        help="compare solution strategies over r on a built-in example",
+        description="Run methods x r on an example and write study.json, study.csv, "
+        "table.md and PNG plots.",
+    )
+    study.add_argument("example", choices=sorted(EXAMPLES), help="which example to solve")
+    study.add_argument(
+        "--methods", type=_methods, default=["penalty", "sua", "nua", "gnrm"],
+        help="comma-separated strategies: penalty,sua,nua,gnrm (default: all four)",
+    )
+    study.add_argument(
+        "--r", type=_floats, default=[1.0, 10.0, 100.0, 1000.0, 10000.0],
+        help="comma-separated r values (default 1,10,100,1000,10000)",
+    )
+    study.add_argument(
+        "--relative", action="store_true",
+        help="read r relative to E/h (h: mean contact facet size) instead of absolute",
+    )
+    study.add_argument(
+        "--quadrature", choices=["nodal", "gauss"], default="nodal",
+        help="contact integration: nodal (vertex rule, node-on-facet) or gauss",
+    )
+    study.add_argument("--tol", type=float, default=1e-8, help="residual tolerance (1e-8)")
+    study.add_argument(
+        "--max-iterations", type=int, default=500,
+        help="Newton iteration limit per load step (500, as in the paper)",
+    )
+    study.add_argument("--out", type=Path, default=Path("results/study"), help="output folder")
+    study.set_defaults(func=_study)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``fenics-contact`` command."""
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.func(args))
+    except (ValueError, FileNotFoundError, RuntimeError) as exc:
+        print(f"fenics-contact: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

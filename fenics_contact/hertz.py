@@ -1,0 +1,197 @@
+"""Hertz line contact: an elastic cylinder on a rigid plane, in plane strain.
+
+Closed-form results of Hertz theory for a cylinder of radius R (length),
+Young's modulus E and Poisson's ratio nu (stress) pressed on a rigid,
+frictionless plane by a normal load P per unit length of the cylinder
+(force per length). With the plane-strain modulus E* = E / (1 - nu^2):
+
+- contact half-width   a  = sqrt(4 P R / (pi E*))        (length);
+- peak pressure        p0 = 2 P / (pi a) = sqrt(P E* / (pi R))   (stress);
+- pressure profile     p(x) = p0 sqrt(1 - x^2 / a^2), |x| <= a.
+
+The pressures here are magnitudes (>= 0); the contact problem's multiplier
+is their negative. Any consistent unit system works (e.g. E in stress units,
+R in length units, P in stress * length).
+
+:func:`fit_contact_profile` measures a and p0 on a mesh from nodal pressures.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+
+def plane_strain_modulus(E: float, nu: float) -> float:
+    """E* = E / (1 - nu^2) of a body against a rigid one (stress units)."""
+    if not E > 0:
+        raise ValueError(f"Young's modulus must be > 0, got E = {E}.")
+    if not -1.0 < nu < 0.5:
+        raise ValueError(f"Poisson's ratio must lie in (-1, 0.5), got nu = {nu}.")
+    return E / (1.0 - nu**2)
+
+
+def _check_positive(**values: float) -> None:
+    for name, value in values.items():
+        if not (np.isfinite(value) and value > 0):
+            raise ValueError(f"{name} must be finite and > 0, got {name} = {value}.")
+
+
+def half_width(P: float, R: float, E: float, nu: float) -> float:
+    """Contact half-width a = sqrt(4 P R / (pi E*)) (length units).
+
+    Args:
+        P: normal load per unit length of the cylinder (force / length).
+        R: cylinder radius (length).
+        E: Young's modulus of the cylinder (stress).
+        nu: Poisson's ratio of the cylinder.
+    """
+    _check_positive(P=P, R=R)
+    return float(np.sqrt(4.0 * P * R / (np.pi * plane_strain_modulus(E, nu))))
+
+
+def peak_pressure(P: float, R: float, E: float, nu: float) -> float:
+    """Peak contact pressure p0 = sqrt(P E* / (pi R)) = 2 P / (pi a) (stress units).
+
+    Args:
+        P: normal load per unit length of the cylinder (force / length).
+        R: cylinder radius (length).
+        E: Young's modulus of the cylinder (stress).
+        nu: Poisson's ratio of the cylinder.
+    """
+    _check_positive(P=P, R=R)
+    return float(np.sqrt(P * plane_strain_modulus(E, nu) / (np.pi * R)))
+
+
+def load_for_half_width(a: float, R: float, E: float, nu: float) -> float:
+    """The load per unit length P = pi E* a^2 / (4 R) that gives half-width ``a``."""
+    _check_positive(a=a, R=R)
+    return float(np.pi * plane_strain_modulus(E, nu) * a**2 / (4.0 * R))
+
+
+def pressure_profile(x: npt.ArrayLike, p0: float, a: float) -> np.ndarray:
+    """Elliptical pressure p(x) = p0 sqrt(1 - x^2/a^2), zero for |x| > a (stress units).
+
+    Args:
+        x: distance along the plane from the centre of contact (length).
+        p0: peak pressure (stress).
+        a: half-width (length).
+    """
+    _check_positive(a=a)
+    xi = np.asarray(x, dtype=float) / a
+    return p0 * np.sqrt(np.clip(1.0 - xi**2, 0.0, None))
+
+
+@dataclass(frozen=True)
+class HertzSolution:
+    """Hertz line contact at one load.
+
+    Attributes:
+        P: load per unit length (force / length).
+        a: contact half-width (length).
+        p0: peak pressure (stress).
+        E_star: plane-strain modulus E / (1 - nu^2) (stress).
+    """
+
+    P: float
+    a: float
+    p0: float
+    E_star: float
+
+    def pressure(self, x: npt.ArrayLike) -> np.ndarray:
+        """Pressure magnitude at ``x`` (stress units)."""
+        return pressure_profile(x, self.p0, self.a)
+
+
+def hertz_line_contact(P: float, R: float, E: float, nu: float) -> HertzSolution:
+    """Half-width and peak pressure of a cylinder (R, E, nu) on a rigid plane under P."""
+    return HertzSolution(
+        P=float(P),
+        a=half_width(P, R, E, nu),
+        p0=peak_pressure(P, R, E, nu),
+        E_star=plane_strain_modulus(E, nu),
+    )
+
+
+@dataclass(frozen=True)
+class ContactProfileFit:
+    """Half-width and peak pressure measured from nodal pressures.
+
+    Attributes:
+        a: half-width of the fitted ellipse p^2 = p0^2 (1 - x^2/a^2) (length).
+        p0: peak of the fitted ellipse (stress, >= 0).
+        nodal_peak: largest nodal pressure magnitude (stress, >= 0).
+        x_peak: position of the node carrying ``nodal_peak`` (length).
+        n_contact: number of nodes in contact used by the fit.
+        x_edge: largest |x - x_c| among the nodes in contact (length).
+    """
+
+    a: float
+    p0: float
+    nodal_peak: float
+    x_peak: float
+    n_contact: int
+    x_edge: float
+
+
+def fit_contact_profile(
+    x: npt.ArrayLike, pressure: npt.ArrayLike, *, centre: float = 0.0
+) -> ContactProfileFit:
+    """Estimate (a, p0) by least squares on p^2 = p0^2 - (p0/a)^2 (x - centre)^2.
+
+    The fit uses every node whose pressure is nonzero (in contact); the
+    squared Hertz profile is linear in x^2, so the fit is a linear
+    regression of p^2 on x^2. It measures the half-width more robustly than
+    the outermost node in contact, whose position is only known to within
+    one element. The nodal peak pressure is reported separately.
+
+    Args:
+        x: coordinate of each node along the plane (length), all nodes of the
+            contact surface (gather them first in parallel).
+        pressure: nodal contact pressure at the same nodes, with either sign
+            convention (stress); magnitudes are used.
+        centre: x-coordinate of the centre of contact (length).
+
+    Returns:
+        The fitted half-width and peak, and the nodal peak.
+
+    Raises:
+        ValueError: when fewer than two nodes are in contact, or the data
+            do not decrease away from the centre (no ellipse fits).
+    """
+    xs = np.asarray(x, dtype=float).ravel() - centre
+    p = np.abs(np.asarray(pressure, dtype=float).ravel())
+    if xs.shape != p.shape:
+        raise ValueError(f"x and pressure differ in size: {xs.size} and {p.size}.")
+    in_contact = p > 0.0
+    n = int(in_contact.sum())
+    if n < 2:
+        raise ValueError(
+            f"Only {n} node(s) in contact: refine the mesh near contact or raise the load."
+        )
+    X2 = xs[in_contact] ** 2
+    P2 = p[in_contact] ** 2
+    # p^2 = c0 - c1 x^2
+    design = np.column_stack([np.ones_like(X2), -X2])
+    (c0, c1), *_ = np.linalg.lstsq(design, P2, rcond=None)
+    if not (c0 > 0 and c1 > 0):
+        raise ValueError(
+            f"The nodal pressures do not fit an ellipse (p0^2 = {c0:.3g}, "
+            f"(p0/a)^2 = {c1:.3g}); check that the contact zone is resolved."
+        )
+    k = int(np.argmax(p))
+    return ContactProfileFit(
+        a=float(np.sqrt(c0 / c1)),
+        p0=float(np.sqrt(c0)),
+        nodal_peak=float(p[k]),
+        x_peak=float(xs[k] + centre),
+        n_contact=n,
+        x_edge=float(np.max(np.abs(xs[in_contact]))),
+    )
+
+
+def relative_error(measured: float, reference: float) -> float:
+    """(measured - reference) / |reference| (dimensionless, signed)."""
+    return float((measured - reference) / abs(reference))

@@ -1,0 +1,14 @@
+"""Shared fixtures; MPI-safe (collect garbage and synchronise after each test)."""
+
+import gc
+
+import fenics_contact  # noqa: F401  (loads the DOLFINx wheel before dolfinx)
+import pytest
+from mpi4py import MPI
+
+
+@pytest.fixture(autouse=True)
+def _mpi_sync():
+    yield
+    gc.collect()
+    MPI.COMM_WORLD.Barrier()

@@ -1,0 +1,50 @@
+"""The status tests of the convergence monitor, on constructed sequences."""
+
+import math
+
+from fenics_contact.diagnostics import ConvergenceMonitor, SolverSettings, Status
+
+
+def feed(monitor, values, states=None):
+    states = states or [None] * len(values)
+    status = None
+    for v, s in zip(values, states, strict=True):
+        status = monitor.check(v, s)
+        if status is not None:
+            return status
+    return status
+
+
+def test_converged_when_below_absolute_or_relative_tolerance():
+    assert feed(ConvergenceMonitor(SolverSettings(atol=1e-8)), [1.0, 1e-3, 1e-9]) == Status.CONVERGED
+    m = ConvergenceMonitor(SolverSettings(atol=1e-20, rtol=1e-6))
+    assert feed(m, [100.0, 1e-2, 1e-5]) == Status.CONVERGED
+    assert m.iterations == 2
+
+
+def test_nan_and_growth_are_divergence():
+    assert feed(ConvergenceMonitor(SolverSettings()), [1.0, math.nan]) == Status.DIVERGED
+    m = ConvergenceMonitor(SolverSettings(divergence_factor=1e3))
+    assert feed(m, [1.0, 10.0, 2e3]) == Status.DIVERGED
+
+
+def test_alternating_active_sets_without_progress_are_cycling():
+    settings = SolverSettings(cycle_window=6, max_iterations=100)
+    values = [1.0] + [0.5, 0.7] * 10
+    states = ["x"] + ["A", "B"] * 10
+    m = ConvergenceMonitor(settings)
+    assert feed(m, values, states) == Status.CYCLING
+    assert m.iterations < 12
+
+
+def test_slow_but_steady_progress_is_not_cycling():
+    settings = SolverSettings(cycle_window=6, max_iterations=30)
+    values = [0.9**k for k in range(40)]
+    states = ["A", "B"] * 20
+    assert feed(ConvergenceMonitor(settings), values, states) == Status.MAX_ITERATIONS
+
+
+def test_iteration_limit():
+    m = ConvergenceMonitor(SolverSettings(max_iterations=3))
+    assert feed(m, [1.0, 0.9, 0.8, 0.7, 0.6]) == Status.MAX_ITERATIONS
+    assert m.iterations == 3

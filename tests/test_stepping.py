@@ -1,0 +1,52 @@
+"""Load stepping: cut-back on failure, and failed paths keep their completed steps."""
+
+import json
+
+import numpy as np
+from mpi4py import MPI
+
+from fenics_contact.contact import ContactSettings
+from fenics_contact.diagnostics import SolverSettings, Status
+from fenics_contact.examples import BarOnCradle
+from fenics_contact.io import StepWriter, write_json
+from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.stepping import solve_load_path
+
+
+def test_one_big_step_is_cut_back_and_reaches_the_ten_step_answer():
+    example = BarOnCradle()
+    reference = example.build(ContactSettings(r=1.0))
+    solve_load_path(make_strategy("gnrm", reference, SolverSettings()), example.steps)
+    problem = example.build(ContactSettings(r=1.0))
+    # The whole load at once needs 7 iterations: 5 forces cut-backs.
+    strategy = make_strategy("gnrm", problem, SolverSettings(max_iterations=5))
+    path = solve_load_path(strategy, 1, max_cutbacks=6)
+    assert path.converged
+    assert path.steps[0].cutbacks >= 1
+    scale = np.abs(reference.u.x.array).max()
+    assert np.abs(problem.u.x.array - reference.u.x.array).max() < 1e-8 * scale
+
+
+def test_failed_path_reports_status_and_keeps_completed_steps(tmp_path):
+    example = BarOnCradle()
+    problem = example.build(ContactSettings(r=10.0, relative=False))
+    # Simultaneous Uzawa at r = 10 needs about 35 iterations a step until all
+    # seven nodes close at step 6, which takes several hundred.
+    strategy = make_strategy("sua", problem, SolverSettings(max_iterations=100))
+    writer = StepWriter(problem, tmp_path / "solution.xdmf")
+    written = []
+
+    def keep(step):
+        writer.write(step.load_factor)
+        written.append(step.step)
+        write_json(tmp_path / "steps.json", written)
+
+    path = solve_load_path(strategy, example.steps, max_cutbacks=0, on_step=keep)
+    writer.close()
+    assert path.status == Status.MAX_ITERATIONS
+    assert len(path.steps) == len(written) + 1
+    assert written and written == list(range(1, len(written) + 1))
+    assert json.loads((tmp_path / "steps.json").read_text()) == written
+    xdmf = (tmp_path / "solution.xdmf").read_text()
+    if MPI.COMM_WORLD.rank == 0:
+        assert xdmf.count('<Attribute Name="displacement"') == len(written)
