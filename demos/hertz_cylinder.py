@@ -46,9 +46,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-import fenics_contact  # noqa: F401  (loads the DOLFINx wheel's libraries first)
 from mpi4py import MPI
 
+import fenics_contact  # noqa: F401  (loads the DOLFINx wheel's libraries first)
 from fenics_contact.contact import ContactSettings
 from fenics_contact.diagnostics import SolverSettings, signorini_report
 from fenics_contact.hertz_problem import HertzCylinder, contact_profile, measure_hertz
@@ -56,8 +56,12 @@ from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.stepping import StepRecord, solve_load_path
 
 parser = argparse.ArgumentParser(description="Hertz line contact validation")
-parser.add_argument("--out", type=Path, default=Path("results/hertz_cylinder"),
-                    help="output directory (default: results/hertz_cylinder)")
+parser.add_argument(
+    "--out",
+    type=Path,
+    default=Path("results/hertz_cylinder"),
+    help="output directory (default: results/hertz_cylinder)",
+)
 parser.add_argument("--steps", type=int, default=4, help="load steps (default: 4)")
 args, _ = parser.parse_known_args()  # tolerate notebook kernel arguments
 
@@ -87,8 +91,10 @@ start = time.perf_counter()
 problem = cylinder.build(settings, comm)
 n_dofs = problem.V.dofmap.index_map.size_global * problem.V.dofmap.index_map_bs
 n_lam = problem.surface.num_dofs
-say(f"Displacement dofs: {n_dofs}, multiplier dofs: {n_lam}, "
-    f"contact facet size h = {problem.surface.h:.4g}")
+say(
+    f"Displacement dofs: {n_dofs}, multiplier dofs: {n_lam}, "
+    f"contact facet size h = {problem.surface.h:.4g}"
+)
 
 # %% [markdown]
 # ## Solve with GNRM
@@ -104,18 +110,20 @@ history: list[dict] = []
 def record(step: StepRecord) -> None:
     """Compare the converged step with Hertz theory."""
     c = measure_hertz(problem, cylinder)
-    history.append({
-        "step": step.step,
-        "push": step.load_factor * cylinder.push,
-        "iterations": step.iterations,
-        "active_nodes": step.active_count,
-        "P": c.P,
-        "a_fit": c.fit.a,
-        "a_hertz": c.hertz.a,
-        "p0_fit": c.fit.p0,
-        "p0_nodal": c.fit.nodal_peak,
-        "p0_hertz": c.hertz.p0,
-    })
+    history.append(
+        {
+            "step": step.step,
+            "push": step.load_factor * cylinder.push,
+            "iterations": step.iterations,
+            "active_nodes": step.active_count,
+            "P": c.P,
+            "a_fit": c.fit.a,
+            "a_hertz": c.hertz.a,
+            "p0_fit": c.fit.p0,
+            "p0_nodal": c.fit.nodal_peak,
+            "p0_hertz": c.hertz.p0,
+        }
+    )
 
 
 path = solve_load_path(strategy, args.steps, on_step=record)
@@ -123,12 +131,16 @@ wall = time.perf_counter() - start
 if not path.converged:
     raise RuntimeError(f"The load path stopped: {path.status}")
 
-say(f"\n{'step':>4} {'push':>7} {'its':>3} {'nodes':>5} {'P':>8} {'a fit':>8} "
-    f"{'a Hertz':>8} {'p0 fit':>8} {'p0 node':>8} {'p0 Hertz':>8}")
+say(
+    f"\n{'step':>4} {'push':>7} {'its':>3} {'nodes':>5} {'P':>8} {'a fit':>8} "
+    f"{'a Hertz':>8} {'p0 fit':>8} {'p0 node':>8} {'p0 Hertz':>8}"
+)
 for h in history:
-    say(f"{h['step']:>4} {h['push']:>7.4f} {h['iterations']:>3} {h['active_nodes']:>5} "
+    say(
+        f"{h['step']:>4} {h['push']:>7.4f} {h['iterations']:>3} {h['active_nodes']:>5} "
         f"{h['P']:>8.4f} {h['a_fit']:>8.5f} {h['a_hertz']:>8.5f} {h['p0_fit']:>8.3f} "
-        f"{h['p0_nodal']:>8.3f} {h['p0_hertz']:>8.3f}")
+        f"{h['p0_nodal']:>8.3f} {h['p0_hertz']:>8.3f}"
+    )
 
 # %% [markdown]
 # ## Comparison at full load
@@ -141,17 +153,20 @@ hertz = comparison.hertz
 rows = [
     ("half-width a (fit)", comparison.fit.a, hertz.a, comparison.a_error),
     ("peak p0 (fit)", comparison.fit.p0, hertz.p0, comparison.p0_error),
-    ("peak p0 (largest nodal)", comparison.fit.nodal_peak, hertz.p0,
-     comparison.nodal_peak_error),
+    ("peak p0 (largest nodal)", comparison.fit.nodal_peak, hertz.p0, comparison.nodal_peak_error),
 ]
-say(f"\nTotal contact force P = {comparison.P:.6f} per unit thickness; "
+say(
+    f"\nTotal contact force P = {comparison.P:.6f} per unit thickness; "
     f"a/R = {hertz.a / cylinder.radius:.4f}, a/h_contact = {hertz.a / cylinder.h_contact:.1f}, "
-    f"{comparison.fit.n_contact} nodes in contact")
+    f"{comparison.fit.n_contact} nodes in contact"
+)
 say(f"{'quantity':<26} {'FE':>10} {'Hertz':>10} {'error':>8}")
 for name, fe, exact, err in rows:
     say(f"{name:<26} {fe:>10.5f} {exact:>10.5f} {100 * err:>7.3f}%")
-say(f"Signorini: min gap {kkt.min_gap:.2e}, max pressure {kkt.max_pressure:.2e}, "
-    f"max |lam g| {kkt.max_complementarity:.2e}; wall time {wall:.1f} s")
+say(
+    f"Signorini: min gap {kkt.min_gap:.2e}, max pressure {kkt.max_pressure:.2e}, "
+    f"max |lam g| {kkt.max_complementarity:.2e}; wall time {wall:.1f} s"
+)
 
 # %% [markdown]
 # ## Outputs: summary.json and the pressure plot
@@ -162,34 +177,47 @@ if root:
     args.out.mkdir(parents=True, exist_ok=True)
     summary = {
         "problem": {
-            "radius": cylinder.radius, "E": cylinder.E, "nu": cylinder.nu,
-            "push": cylinder.push, "material": "linear elastic, plane strain",
+            "radius": cylinder.radius,
+            "E": cylinder.E,
+            "nu": cylinder.nu,
+            "push": cylinder.push,
+            "material": "linear elastic, plane strain",
         },
         "mesh": {
-            "h_contact": cylinder.h_contact, "h_far": cylinder.h_far,
-            "fine_radius": cylinder.fine_radius, "coarse_radius": cylinder.coarse_radius,
+            "h_contact": cylinder.h_contact,
+            "h_far": cylinder.h_far,
+            "fine_radius": cylinder.fine_radius,
+            "coarse_radius": cylinder.coarse_radius,
             "contact_band": cylinder.contact_band,
-            "displacement_dofs": n_dofs, "multiplier_dofs": n_lam,
+            "displacement_dofs": n_dofs,
+            "multiplier_dofs": n_lam,
         },
         "solver": {
-            "strategy": "gnrm", "quadrature": settings.quadrature, "r_relative": settings.r,
+            "strategy": "gnrm",
+            "quadrature": settings.quadrature,
+            "r_relative": settings.r,
             "load_steps": args.steps,
             "iterations_per_step": [s.iterations for s in path.steps],
-            "wall_s": wall, "mpi_ranks": comm.size,
+            "wall_s": wall,
+            "mpi_ranks": comm.size,
         },
         "P": comparison.P,
         "hertz": {"a": hertz.a, "p0": hertz.p0, "E_star": hertz.E_star},
         "measured": {
-            "a_fit": comparison.fit.a, "p0_fit": comparison.fit.p0,
-            "p0_nodal": comparison.fit.nodal_peak, "x_nodal_peak": comparison.fit.x_peak,
+            "a_fit": comparison.fit.a,
+            "p0_fit": comparison.fit.p0,
+            "p0_nodal": comparison.fit.nodal_peak,
+            "x_nodal_peak": comparison.fit.x_peak,
             "nodes_in_contact": comparison.fit.n_contact,
         },
         "relative_error": {
-            "a_fit": comparison.a_error, "p0_fit": comparison.p0_error,
+            "a_fit": comparison.a_error,
+            "p0_fit": comparison.p0_error,
             "p0_nodal": comparison.nodal_peak_error,
         },
         "signorini": {
-            "min_gap": kkt.min_gap, "max_pressure": kkt.max_pressure,
+            "min_gap": kkt.min_gap,
+            "max_pressure": kkt.max_pressure,
             "max_complementarity": kkt.max_complementarity,
         },
         "load_steps": history,
@@ -205,8 +233,10 @@ if root:
     ax.axvline(comparison.fit.a, color="tab:blue", ls=":", lw=1)
     ax.set_xlabel("x (reference)")
     ax.set_ylabel("contact pressure -lam")
-    ax.set_title(f"Hertz cylinder: a/R = {hertz.a / cylinder.radius:.3f}, "
-                 f"{comparison.fit.n_contact} nodes in contact")
+    ax.set_title(
+        f"Hertz cylinder: a/R = {hertz.a / cylinder.radius:.3f}, "
+        f"{comparison.fit.n_contact} nodes in contact"
+    )
     ax.legend(loc="upper right", fontsize=8)
     fig.tight_layout()
     fig.savefig(args.out / "pressure.png", dpi=150)

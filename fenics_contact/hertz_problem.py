@@ -11,6 +11,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 from dolfinx import mesh
+
 from mpi4py import MPI
 
 from fenics_contact.contact import ContactSettings
@@ -73,9 +74,7 @@ class HertzCylinder:
         """The small-strain law of the body."""
         return LinearElastic(E=self.E, nu=self.nu)
 
-    def build(
-        self, settings: ContactSettings, comm: MPI.Comm = MPI.COMM_WORLD
-    ) -> ContactProblem:
+    def build(self, settings: ContactSettings, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProblem:
         """Mesh the half-disk with gmsh and create the contact problem.
 
         Args:

@@ -8,6 +8,7 @@ The gmsh model is created on one MPI rank only and distributed by
 from __future__ import annotations
 
 from dolfinx.io.gmsh import MeshData, model_to_mesh
+
 from mpi4py import MPI
 
 #: Physical tag of the half-disk surface (cells).
@@ -67,8 +68,7 @@ def hertz_half_disk(
         raise ValueError(f"The disk radius must be > 0, got {radius}.")
     if not 0 < h_contact <= h_far:
         raise ValueError(
-            f"Element sizes need 0 < h_contact <= h_far, got h_contact={h_contact}, "
-            f"h_far={h_far}."
+            f"Element sizes need 0 < h_contact <= h_far, got h_contact={h_contact}, h_far={h_far}."
         )
     fine = 0.1 * radius if fine_radius is None else fine_radius
     coarse = 0.5 * radius if coarse_radius is None else coarse_radius
@@ -97,7 +97,7 @@ def hertz_half_disk(
 
 
 def _build_half_disk(
-    gmsh,  # noqa: ANN001 (the gmsh module)
+    gmsh,  # the gmsh module (imported lazily)
     radius: float,
     h_contact: float,
     h_far: float,

@@ -19,9 +19,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import fenics_contact  # noqa: F401  (before dolfinx)
 from mpi4py import MPI
 
+import fenics_contact  # noqa: F401  (before dolfinx)
 from fenics_contact.contact import ContactSettings
 from fenics_contact.diagnostics import SolverSettings
 from fenics_contact.hertz import (
