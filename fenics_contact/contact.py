@@ -107,8 +107,18 @@ class ContactSurface:
     """
 
     def __init__(
-        self, domain: mesh.Mesh, facets: np.ndarray, quadrature: Quadrature = "nodal"
+        self,
+        domain: mesh.Mesh,
+        facets: np.ndarray,
+        quadrature: Quadrature = "nodal",
+        tags: mesh.MeshTags | None = None,
     ) -> None:
+        """Build the submesh and multiplier space.
+
+        ``tags``: facet tags of the whole body in which ``facets`` carry
+        :data:`CONTACT_TAG` (one tag set must serve every ``ds`` of a form);
+        made here when not given.
+        """
         fdim = domain.topology.dim - 1
         domain.topology.create_connectivity(fdim, domain.topology.dim)
         facets = np.unique(np.asarray(facets, dtype=np.int32))
@@ -121,7 +131,7 @@ class ContactSurface:
         self.domain = domain
         self.facets = facets
         self.quadrature = quadrature
-        self.tags = mesh.meshtags(
+        self.tags = tags if tags is not None else mesh.meshtags(
             domain, fdim, facets, np.full(facets.size, CONTACT_TAG, dtype=np.int32)
         )
         self.submesh, self.entity_map, _, _ = mesh.create_submesh(domain, fdim, facets)

@@ -18,6 +18,7 @@ from dolfinx import default_scalar_type, fem, mesh
 from mpi4py import MPI
 
 from fenics_contact.contact import (
+    CONTACT_TAG,
     ContactSettings,
     ContactSurface,
     augmented_lagrangian_energy,
@@ -48,6 +49,29 @@ class SurfaceTraction:
 
     facets: np.ndarray
     value: tuple[float, ...]
+
+
+#: Facet tag of the first traction; the i-th traction has TRACTION_TAG0 + i.
+TRACTION_TAG0 = 100
+
+
+def _facet_tags(
+    domain: mesh.Mesh, contact_facets: np.ndarray, tractions: Sequence[SurfaceTraction]
+) -> mesh.MeshTags:
+    """One facet tag set for every ``ds``: contact facets and each traction's facets."""
+    fdim = domain.topology.dim - 1
+    groups = [(np.unique(np.asarray(contact_facets, np.int32)), CONTACT_TAG)] + [
+        (np.asarray(t.facets, np.int32), TRACTION_TAG0 + i) for i, t in enumerate(tractions)
+    ]
+    facets = np.concatenate([f for f, _ in groups])
+    values = np.concatenate([np.full(f.size, tag, np.int32) for f, tag in groups])
+    if np.unique(facets).size != facets.size:
+        raise ValueError(
+            "A facet is listed twice among the contact surface and the tractions; "
+            "give each facet one role."
+        )
+    order = np.argsort(facets)
+    return mesh.meshtags(domain, fdim, facets[order], values[order])
 
 
 @dataclass
@@ -113,7 +137,10 @@ class ContactProblem:
         self.settings = settings
         self.V = fem.functionspace(domain, ("Lagrange", degree, (gdim,)))
         self.u = fem.Function(self.V, name="displacement")
-        self.surface = ContactSurface(domain, contact_facets, settings.quadrature)
+        self.facet_tags = _facet_tags(domain, contact_facets, tractions)
+        self.surface = ContactSurface(
+            domain, contact_facets, settings.quadrature, tags=self.facet_tags
+        )
         self.Q = self.surface.Q
         self.lam = fem.Function(self.Q, name="contact_pressure")
         self.r = fem.Constant(domain, default_scalar_type(1.0))
@@ -192,21 +219,18 @@ class ContactProblem:
         return bcs
 
     def _external_work(self, tractions: Sequence[SurfaceTraction]) -> ufl.Form | None:
-        fdim = self.domain.topology.dim - 1
         if not tractions:
             return None
-        facets = np.concatenate([np.asarray(t.facets, np.int32) for t in tractions])
-        values = np.concatenate(
-            [np.full(len(t.facets), i + 1, np.int32) for i, t in enumerate(tractions)]
-        )
-        order = np.argsort(facets)
-        tags = mesh.meshtags(self.domain, fdim, facets[order], values[order])
-        ds = ufl.Measure("ds", domain=self.domain, subdomain_data=tags)
+        ds = ufl.Measure("ds", domain=self.domain, subdomain_data=self.facet_tags)
         work = 0
         for i, traction in enumerate(tractions):
+            if len(traction.value) != self.domain.geometry.dim:
+                raise ValueError(
+                    f"Traction {traction.value} needs {self.domain.geometry.dim} components."
+                )
             const = fem.Constant(self.domain, np.zeros(self.domain.geometry.dim))
             self._traction_constants.append((const, np.asarray(traction.value, float)))
-            work += ufl.dot(const, self.u) * ds(i + 1)
+            work += ufl.dot(const, self.u) * ds(TRACTION_TAG0 + i)
         return work
 
     # -- systems handed to solvers -------------------------------------------

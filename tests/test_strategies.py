@@ -1,0 +1,114 @@
+"""Each strategy against GNRM and the exact answer; real cycling and divergence."""
+
+import json
+
+import numpy as np
+import pytest
+from dolfinx import mesh
+from mpi4py import MPI
+
+from fenics_contact.cli import main
+from fenics_contact.contact import ContactSettings
+from fenics_contact.diagnostics import SolverSettings, Status
+from fenics_contact.examples import BarOnCradle, WedgeOnCorner
+from fenics_contact.materials import SaintVenantKirchhoff
+from fenics_contact.obstacles import RigidPlane
+from fenics_contact.problem import ContactProblem, SurfaceTraction
+from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.stepping import solve_load_path
+
+EX1 = WedgeOnCorner()
+EX2 = BarOnCradle()
+
+
+def corner_u(method, r, max_iterations=500):
+    problem = EX1.build(ContactSettings(r=r, relative=False))
+    strategy = make_strategy(method, problem, SolverSettings(max_iterations=max_iterations))
+    path = solve_load_path(strategy, EX1.steps, max_cutbacks=0)
+    return path, EX1.corner_displacement(problem)
+
+
+@pytest.mark.parametrize("method", ["gnrm", "sua", "nua"])
+def test_augmented_lagrangian_strategies_hit_the_exact_answer(method):
+    path, u = corner_u(method, 1000.0)
+    assert path.converged
+    assert u == pytest.approx(EX1.exact_u, abs=1e-9)
+
+
+def test_gnrm_takes_two_iterations_whatever_r():
+    for r in (1.0, 10.0, 100.0, 1000.0, 1e4):
+        path, _ = corner_u("gnrm", r)
+        assert path.converged and path.iterations == 2
+
+
+def test_penalty_error_falls_like_one_over_r_on_example_1():
+    errors = [abs(corner_u("penalty", r)[1] - EX1.exact_u) for r in (1e4, 1e5, 1e6)]
+    for k in range(2):
+        assert errors[k] / errors[k + 1] == pytest.approx(10.0, rel=0.2)
+
+
+@pytest.mark.parametrize(("method", "r"), [("nua", 1000.0), ("penalty", 1e5)])
+def test_example_2_strategies_agree_with_gnrm(method, r):
+    reference = EX2.build(ContactSettings(r=r, relative=False))
+    solve_load_path(make_strategy("gnrm", reference, SolverSettings()), EX2.steps)
+    problem = EX2.build(ContactSettings(r=r, relative=False))
+    path = solve_load_path(
+        make_strategy(method, problem, SolverSettings(max_iterations=500)), EX2.steps,
+        max_cutbacks=0,
+    )
+    assert path.converged
+    diff = np.abs(problem.u.x.array - reference.u.x.array).max()
+    # NUA is exact to the tolerance; penalty is off by about pressure / r
+    tolerance = 1e-8 if method == "nua" else 50.0 / r
+    assert diff < tolerance
+
+
+def test_simultaneous_uzawa_cycles_on_example_2_at_large_r():
+    problem = EX2.build(ContactSettings(r=1000.0, relative=False))
+    strategy = make_strategy("sua", problem, SolverSettings(max_iterations=500))
+    result = solve_load_path(strategy, EX2.steps, max_cutbacks=0)
+    assert result.status == Status.CYCLING
+    assert result.steps[0].iterations < 50
+
+
+def test_singular_system_is_reported_as_divergence_not_an_exception():
+    """A traction, no Dirichlet condition and no contact: the stiffness is singular."""
+    domain = mesh.create_unit_square(MPI.COMM_WORLD, 2, 2)
+    fdim = 1
+    bottom = mesh.locate_entities_boundary(domain, fdim, lambda x: np.isclose(x[1], 0.0))
+    plane = RigidPlane(domain, [0.0, -1.0], [0.0, 1.0])
+    top = mesh.locate_entities_boundary(domain, fdim, lambda x: np.isclose(x[1], 1.0))
+    problem = ContactProblem(
+        domain, SaintVenantKirchhoff(210.0, 0.3), plane, bottom, ContactSettings(),
+        tractions=[SurfaceTraction(top, (1.0, 0.0))],
+    )
+    path = solve_load_path(make_strategy("gnrm", problem, SolverSettings()), 1, max_cutbacks=1)
+    assert path.status == Status.DIVERGED
+    assert np.all(np.isfinite(problem.u.x.array))
+
+
+def test_study_command_writes_the_table_json_csv_and_plots(tmp_path, capsys):
+    code = main(
+        ["study", "paper-ex1", "--methods", "penalty,gnrm", "--r", "10,1000", "--out",
+         str(tmp_path)]
+    )
+    assert code == 0
+    printed = capsys.readouterr().out
+    assert "| GNRM | 2 | 2 |" in printed
+    records = json.loads((tmp_path / "study.json").read_text())
+    assert len(records) == 4
+    keys = {"method", "r", "status", "iterations", "updates", "wall_s", "max_penetration", "error"}
+    assert all(keys <= set(rec) for rec in records)
+    gnrm = [rec for rec in records if rec["method"] == "gnrm"]
+    assert all(rec["error"] < 1e-12 for rec in gnrm)
+    header = (tmp_path / "study.csv").read_text().splitlines()[0].split(",")
+    assert keys <= set(header)
+    for png in ("residuals.png", "iterations.png"):
+        assert (tmp_path / png).stat().st_size > 10_000
+
+
+def test_study_command_rejects_bad_r_before_any_work(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["study", "paper-ex1", "--r", "10,-1"])
+    assert exc.value.code == 2
+    assert "every r must be > 0" in capsys.readouterr().err
