@@ -1,16 +1,13 @@
-"""The ``fenics-contact`` command."""
+"""``fenics-contact study``: method x r sweeps on a built-in example."""
 
 from __future__ import annotations
 
 import argparse
-import sys
-from collections.abc import Sequence
 from pathlib import Path
 
-import fenics_contact  # noqa: F401  (imports the DOLFINx wheel first)
 
-
-def _floats(text: str) -> list[float]:
+def floats(text: str) -> list[float]:
+    """Parse a comma-separated list of positive numbers (argparse type)."""
     try:
         values = [float(v) for v in text.split(",") if v.strip()]
     except ValueError:
@@ -22,7 +19,8 @@ def _floats(text: str) -> list[float]:
     return values
 
 
-def _methods(text: str) -> list[str]:
+def methods(text: str) -> list[str]:
+    """Parse a comma-separated list of strategy names (argparse type)."""
     from fenics_contact.solvers import STRATEGIES
 
     names = [m.strip().lower() for m in text.split(",") if m.strip()]
@@ -69,29 +67,24 @@ def _study(args: argparse.Namespace) -> int:
     return 0
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser with every subcommand."""
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the ``study`` subcommand."""
     from fenics_contact.examples import EXAMPLES
 
-    parser = argparse.ArgumentParser(
-        prog="fenics-contact",
-        description="Finite-deformation contact with the Alart-Curnier augmented Lagrangian.",
-    )
-    sub = parser.add_subparsers(dest="command", required=True)
     study = sub.add_parser(
         "study",
         help="compare solution strategies over r on a built-in example",
         description="Run methods x r on an example and write study.json, study.csv, "
-        "table.md and PNG plots.",
+        "table.md and PNG plots (residual histories, iterations against r).",
     )
     study.add_argument("example", choices=sorted(EXAMPLES), help="which example to solve")
     study.add_argument(
-        "--methods", type=_methods, default=["penalty", "sua", "nua", "gnrm"],
+        "--methods", type=methods, default=["penalty", "sua", "nua", "gnrm"],
         help="comma-separated strategies: penalty,sua,nua,gnrm (default: all four)",
     )
     study.add_argument(
-        "--r", type=_floats, default=[1.0, 10.0, 100.0, 1000.0, 10000.0],
-        help="comma-separated r values (default 1,10,100,1000,10000)",
+        "--r", type=floats, default=[1.0, 10.0, 100.0, 1000.0, 10000.0],
+        help="comma-separated r values, e.g. 1e6,1e8 (default 1,10,100,1000,10000)",
     )
     study.add_argument(
         "--relative", action="store_true",
@@ -108,18 +101,3 @@ def build_parser() -> argparse.ArgumentParser:
     )
     study.add_argument("--out", type=Path, default=Path("results/study"), help="output folder")
     study.set_defaults(func=_study)
-    return parser
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``fenics-contact`` command."""
-    args = build_parser().parse_args(argv)
-    try:
-        return int(args.func(args))
-    except (ValueError, FileNotFoundError, RuntimeError) as exc:
-        print(f"fenics-contact: error: {exc}", file=sys.stderr)
-        return 2
-
-
-if __name__ == "__main__":
-    sys.exit(main())

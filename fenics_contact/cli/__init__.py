@@ -1,0 +1,40 @@
+"""The ``fenics-contact`` command: one module a subcommand, each with ``register``."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+import fenics_contact  # noqa: F401  (imports the DOLFINx wheel first)
+
+#: Subcommand modules, in the order ``--help`` lists them.
+SUBCOMMANDS = ("study",)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser with every subcommand."""
+    parser = argparse.ArgumentParser(
+        prog="fenics-contact",
+        description="Finite-deformation contact of hyperelastic bodies with the "
+        "Alart-Curnier augmented Lagrangian (FEniCSx).",
+    )
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for name in SUBCOMMANDS:
+        importlib.import_module(f"fenics_contact.cli.{name}").register(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``fenics-contact`` command; returns the exit code."""
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.func(args))
+    except (ValueError, FileNotFoundError, RuntimeError) as exc:
+        print(f"fenics-contact: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())
