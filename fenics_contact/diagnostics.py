@@ -15,7 +15,7 @@ Statuses, with their defined tests (checked in this order each iteration):
 from __future__ import annotations
 
 import math
-from collections.abc import Hashable
+from collections.abc import Callable, Hashable
 from dataclasses import dataclass, field
 from enum import StrEnum
 
@@ -63,6 +63,8 @@ class ConvergenceMonitor:
     """Records residuals and active sets of one solve and decides its status."""
 
     settings: SolverSettings
+    #: Called with (Newton iterations so far, residual) at every check (progress display).
+    observer: Callable[[int, float], None] | None = None
     residuals: list[float] = field(default_factory=list)
     states: list[Hashable] = field(default_factory=list)
     status: Status | None = None
@@ -84,6 +86,8 @@ class ConvergenceMonitor:
         """
         self.iterations = len(self.residuals) if iterations is None else iterations
         self.residuals.append(float(residual))
+        if self.observer is not None:
+            self.observer(self.iterations, float(residual))
         self.states.append(state if state is not None else round(math.log10(residual + 1e-300), 3)
                            if math.isfinite(residual) else None)
         s = self.settings

@@ -52,25 +52,53 @@ class Elastic:
     #: Whether the law is geometrically nonlinear (finite strain).
     finite_strain: bool = True
 
-    def strain_energy(self, u: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
-        """Stored energy density psi(u) per unit reference volume."""
+    def energy(self, H: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+        """Stored energy density as a function of the displacement gradient H (d x d).
+
+        With d = 2 the body is in plane strain (out-of-plane stretch one).
+        """
         raise NotImplementedError
 
+    def strain_energy(self, u: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+        """Stored energy density psi(u) per unit reference volume."""
+        return self.energy(ufl.grad(u))
 
-def deformation_gradient(u: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
-    """F = I + grad u (reference gradient)."""
-    d = len(u)
-    return ufl.Identity(d) + ufl.grad(u)
+    def cauchy_stress(self, u: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+        """Cauchy stress (3 x 3, out-of-plane component included in plane strain).
+
+        Obtained as sigma = (1/J) P F^T with P = d psi / d H; the small-strain
+        law returns P itself.
+        """
+        H = ufl.variable(_embed_3d(ufl.grad(u)))
+        P = ufl.diff(self.energy(H), H)
+        if not self.finite_strain:
+            return P
+        F = ufl.Identity(3) + H
+        return P * F.T / ufl.det(F)
+
+
+def _embed_3d(H: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+    """A 2 x 2 plane-strain displacement gradient as a 3 x 3 one (3D: unchanged)."""
+    if H.ufl_shape == (3, 3):
+        return H
+    return ufl.as_matrix([[H[0, 0], H[0, 1], 0], [H[1, 0], H[1, 1], 0], [0, 0, 0]])
+
+
+def von_mises(sigma: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+    """Von Mises equivalent stress sqrt(3/2 s:s) of a 3 x 3 stress."""
+    s = ufl.dev(sigma)
+    return ufl.sqrt(1.5 * ufl.inner(s, s))
 
 
 @dataclass(frozen=True)
 class SaintVenantKirchhoff(Elastic):
     """psi = lmbda/2 (tr E)^2 + mu E:E with the Green-Lagrange strain E (the paper's law)."""
 
-    def strain_energy(self, u: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+    def energy(self, H: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
         """Stored energy density."""
-        F = deformation_gradient(u)
-        Egl = 0.5 * (F.T * F - ufl.Identity(len(u)))
+        d = H.ufl_shape[0]
+        F = ufl.Identity(d) + H
+        Egl = 0.5 * (F.T * F - ufl.Identity(d))
         return 0.5 * self.lmbda * ufl.tr(Egl) ** 2 + self.mu * ufl.inner(Egl, Egl)
 
 
@@ -81,13 +109,12 @@ class NeoHookean(Elastic):
     In plane strain I1 = tr(C) + 1 (the out-of-plane stretch is one).
     """
 
-    def strain_energy(self, u: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+    def energy(self, H: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
         """Stored energy density."""
-        d = len(u)
-        F = deformation_gradient(u)
-        J = ufl.det(F)
+        d = H.ufl_shape[0]
+        F = ufl.Identity(d) + H
+        lnJ = ufl.ln(ufl.det(F))
         I1 = ufl.tr(F.T * F) + (3 - d)
-        lnJ = ufl.ln(J)
         return 0.5 * self.mu * (I1 - 3) - self.mu * lnJ + 0.5 * self.lmbda * lnJ**2
 
 
@@ -101,9 +128,9 @@ class LinearElastic(Elastic):
 
     finite_strain: bool = False
 
-    def strain_energy(self, u: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+    def energy(self, H: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
         """Stored energy density."""
-        eps = ufl.sym(ufl.grad(u))
+        eps = ufl.sym(H)
         return 0.5 * self.lmbda * ufl.tr(eps) ** 2 + self.mu * ufl.inner(eps, eps)
 
 

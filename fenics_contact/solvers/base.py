@@ -90,6 +90,8 @@ class MonolithicNewton:
     """Plain Newton on one system built by :meth:`build_system` (GNRM and PM)."""
 
     name = "newton"
+    #: Optional progress callback (iterations, residual), see ConvergenceMonitor.
+    observer: Callable[[int, float], None] | None = None
 
     def __init__(self, problem: ContactProblem, settings: SolverSettings) -> None:
         self.problem = problem
@@ -105,7 +107,7 @@ class MonolithicNewton:
         return timed(self._solve)
 
     def _solve(self) -> SolveResult:
-        monitor = ConvergenceMonitor(self.settings)
+        monitor = ConvergenceMonitor(self.settings, observer=self.observer)
         before = self.kernel.linear_solves
         status, steps = newton_loop(
             self.kernel, monitor, self.kernel.assemble_residual, self.problem.active_signature

@@ -43,7 +43,7 @@ class NestedUzawa(UzawaBase):
         return timed(self._solve)
 
     def _solve(self) -> SolveResult:
-        monitor = ConvergenceMonitor(self.settings)
+        monitor = ConvergenceMonitor(self.settings, observer=self.observer)
         before = self.kernel.linear_solves
         steps = updates = 0
         fresh = True  # a Newton step was taken since the last update

@@ -17,7 +17,7 @@ class SimultaneousUzawa(UzawaBase):
         return timed(self._solve)
 
     def _solve(self) -> SolveResult:
-        monitor = ConvergenceMonitor(self.settings)
+        monitor = ConvergenceMonitor(self.settings, observer=self.observer)
         before = self.kernel.linear_solves
         status, steps = newton_loop(
             self.kernel,

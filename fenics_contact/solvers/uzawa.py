@@ -9,6 +9,7 @@ complementarity lam - min(lam + r g, 0)).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 from dolfinx import fem
 from mpi4py import MPI
@@ -23,6 +24,8 @@ class UzawaBase:
     """Primal Newton kernel plus the complementarity residual."""
 
     name = "uzawa"
+    #: Optional progress callback (iterations, residual), see ConvergenceMonitor.
+    observer: Callable[[int, float], None] | None = None
 
     def __init__(self, problem: ContactProblem, settings: SolverSettings) -> None:
         self.problem = problem
