@@ -9,13 +9,15 @@ from __future__ import annotations
 import csv
 import json
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 from dolfinx import fem, io
 
+from fenics_contact.materials import von_mises
 from fenics_contact.problem import ContactProblem
+from fenics_contact.scene import FIELDS
 
 
 def _clean(value: object) -> object:
@@ -77,39 +79,62 @@ class SurfaceToBody:
 
 
 class StepWriter:
-    """Writes displacement, contact pressure, gap and active set at every step.
+    """Writes the chosen fields at every load step into one XDMF file (with its .h5).
 
-    One XDMF file (with its .h5) on the body mesh; time = load factor.
-    DOLFINx rewrites the XDMF index at each write, so completed steps survive a failure.
+    Fields: displacement (P1 vector), contact_pressure, gap and active (P1
+    scalars, zero off the contact surface) and von_mises (cell-wise Cauchy
+    von Mises stress). Time is the load factor. DOLFINx rewrites the XDMF
+    index at each write, so completed steps survive a later failure.
     """
 
-    def __init__(self, problem: ContactProblem, path: Path) -> None:
+    def __init__(
+        self, problem: ContactProblem, path: Path, fields: Sequence[str] = FIELDS
+    ) -> None:
         if problem.V.ufl_element().embedded_superdegree != 1:
             raise ValueError("XDMF output needs P1 displacement; interpolate higher orders first.")
-        path.parent.mkdir(parents=True, exist_ok=True)
+        unknown = set(fields) - set(FIELDS)
+        if unknown:
+            raise ValueError(f"Unknown output fields {sorted(unknown)}; choose from {FIELDS}.")
+        if problem.comm.rank == 0:
+            path.parent.mkdir(parents=True, exist_ok=True)
+        problem.comm.Barrier()
         self.problem = problem
         self.path = path
+        self.fields = tuple(fields)
         self.mapper = SurfaceToBody(problem)
+        self._q = fem.Function(problem.Q)
+        self._stress = None
+        if "von_mises" in self.fields:
+            S = fem.functionspace(problem.domain, ("DG", 0))
+            self._stress = fem.Function(S, name="von_mises")
+            sigma = problem.material.cauchy_stress(problem.u)
+            self._stress_expr = fem.Expression(von_mises(sigma), S.element.interpolation_points)
         self.file = io.XDMFFile(problem.comm, str(path), "w")
         self.file.write_mesh(problem.domain)
+
+    def _surface_field(self, name: str, values: np.ndarray) -> fem.Function:
+        self._q.x.array[: values.size] = values
+        self._q.x.scatter_forward()
+        return self.mapper.field(name, self._q.x.array)
 
     def write(self, t: float) -> None:
         """Append the current fields at load factor ``t``."""
         p = self.problem
-        q = fem.Function(p.Q)
         state = p.contact_state()
-        n = state.gap.size
-        fields = [p.u]
-        for name, values in (
-            ("contact_pressure", state.pressure),
-            ("gap", state.gap),
-            ("active", state.active.astype(float)),
-        ):
-            q.x.array[:n] = values
-            q.x.scatter_forward()
-            fields.append(self.mapper.field(name, q.x.array))
-        for f in fields:
-            self.file.write_function(f, t)
+        surface = {
+            "contact_pressure": state.pressure,
+            "gap": state.gap,
+            "active": state.active.astype(float),
+        }
+        for name in self.fields:
+            if name == "displacement":
+                self.file.write_function(p.u, t)
+            elif name == "von_mises":
+                assert self._stress is not None
+                self._stress.interpolate(self._stress_expr)
+                self.file.write_function(self._stress, t)
+            else:
+                self.file.write_function(self._surface_field(name, surface[name]), t)
 
     def close(self) -> None:
         """Close the file."""

@@ -58,3 +58,20 @@ def iterations_against_r(records: Sequence[RunRecord], path: Path) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=120)
     plt.close(fig)
+
+
+def step_residuals(steps: Sequence, path: Path, title: str = "") -> None:
+    """Residual against Newton iteration, one line per load step (semilog)."""
+    fig, ax = plt.subplots(figsize=(5.5, 4))
+    for step in steps:
+        history = [v for solve in step.residuals for v in solve]
+        ax.semilogy(range(len(history)), history, "o-", ms=3, lw=1, label=f"step {step.step}")
+    ax.set_xlabel("Newton iteration")
+    ax.set_ylabel("static residual (L2 norm)")
+    ax.set_title(title)
+    if len(steps) <= 12:
+        ax.legend(fontsize=7, ncol=2)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import ufl
+import ufl.algorithms
 from dolfinx import default_scalar_type, fem, mesh
 from mpi4py import MPI
 
@@ -49,6 +50,21 @@ class SurfaceTraction:
 
     facets: np.ndarray
     value: tuple[float, ...]
+
+
+def energy_quadrature_degree(psi: ufl.core.expr.Expr, u: fem.Function, degree: int) -> int:
+    """Quadrature degree for the strain energy and its derivatives.
+
+    UFL's estimate for the tangent, capped at 2 (degree + 1): exact for
+    linear elasticity and St. Venant-Kirchhoff on simplices and for linear
+    elasticity on quadrilaterals/hexahedra, and it keeps non-polynomial
+    laws (neo-Hookean: estimate 17 on hexahedra) affordable.
+    """
+    v = ufl.TestFunction(u.function_space)
+    tangent = ufl.derivative(ufl.derivative(psi * ufl.dx, u, v), u)
+    integrand = ufl.algorithms.expand_derivatives(tangent).integrals()[0].integrand()
+    estimate = ufl.algorithms.estimate_total_polynomial_degree(integrand)
+    return int(min(estimate, 2 * (degree + 1)))
 
 
 #: Facet tag of the first traction; the i-th traction has TRACTION_TAG0 + i.
@@ -158,7 +174,12 @@ class ContactProblem:
         x = ufl.SpatialCoordinate(domain) + self.u
         self.gap = obstacle.gap(x)
         self.pressure = augmented_pressure(self.gap, self.lam, self.r)
-        self.potential = material.strain_energy(self.u) * ufl.dx
+        psi = material.strain_energy(self.u)
+        dx = ufl.Measure(
+            "dx", domain=domain,
+            metadata={"quadrature_degree": energy_quadrature_degree(psi, self.u, degree)},
+        )
+        self.potential = psi * dx
         if external is not None:
             self.potential -= external
 

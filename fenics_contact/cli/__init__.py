@@ -10,7 +10,7 @@ from collections.abc import Sequence
 import fenics_contact  # noqa: F401  (imports the DOLFINx wheel first)
 
 #: Subcommand modules, in the order ``--help`` lists them.
-SUBCOMMANDS = ("study",)
+SUBCOMMANDS = ("run", "study", "mesh")
 
 
 def build_parser() -> argparse.ArgumentParser:

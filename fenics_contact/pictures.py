@@ -1,0 +1,96 @@
+"""Pictures of a solved problem: the deformed body coloured by contact pressure.
+
+PyVista renders off-screen (no display needed). The body is drawn deformed
+(true scale) and coloured by the contact pressure -lam (zero off the
+contact surface, so the colour shows where and how hard the body presses);
+the rigid obstacle is drawn in grey.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from dolfinx import fem, plot
+
+from fenics_contact.io import SurfaceToBody
+from fenics_contact.obstacles import RigidBall, RigidPlane
+from fenics_contact.problem import ContactProblem
+
+
+def _obstacle_mesh(problem: ContactProblem, bounds: np.ndarray):  # noqa: ANN202
+    import pyvista
+
+    obstacle = problem.obstacle
+    gdim = problem.domain.geometry.dim
+    centre = np.zeros(3)
+    centre[:gdim] = obstacle.point.value
+    span = float(np.max(bounds[1] - bounds[0]))
+    if isinstance(obstacle, RigidPlane):
+        normal = np.zeros(3)
+        normal[:gdim] = obstacle.normal.value
+        mid = 0.5 * (bounds[0] + bounds[1])
+        # the point of the plane nearest the body's centre
+        foot = mid - np.dot(mid - centre, normal) * normal
+        if gdim == 2:
+            tangent = np.array([normal[1], -normal[0], 0.0])
+            return pyvista.Line(foot - 0.75 * span * tangent, foot + 0.75 * span * tangent)
+        return pyvista.Plane(center=foot, direction=normal, i_size=1.5 * span, j_size=1.5 * span)
+    assert isinstance(obstacle, RigidBall)
+    radius = float(obstacle.radius.value)
+    if gdim == 2:
+        angles = np.linspace(0.0, 2.0 * np.pi, 721)
+        ring = np.column_stack([np.cos(angles), np.sin(angles), 0.0 * angles]) * radius
+        return pyvista.MultipleLines(ring + centre)
+    return pyvista.Sphere(radius=radius, center=centre, theta_resolution=60, phi_resolution=60)
+
+
+def deformed_contact_picture(problem: ContactProblem, path: Path, title: str = "") -> None:
+    """Render the deformed body coloured by contact pressure into a PNG.
+
+    Serial runs only (returns without drawing on more processes: the XDMF
+    file holds the whole body for ParaView).
+    """
+    import pyvista
+
+    if problem.comm.size > 1:
+        return
+    pyvista.OFF_SCREEN = True
+    # without a display VTK warns once that X is missing, then renders off-screen
+    pyvista.vtk_verbosity("off")
+    mapper = SurfaceToBody(problem)
+    state = problem.contact_state()
+    q = fem.Function(problem.Q)
+    q.x.array[: state.pressure.size] = -state.pressure
+    q.x.scatter_forward()
+    pressure = mapper.field("p", q.x.array)
+    topology, cells, geometry = plot.vtk_mesh(problem.V)
+    grid = pyvista.UnstructuredGrid(topology, cells, geometry.copy())
+    gdim = problem.domain.geometry.dim
+    disp = np.zeros((geometry.shape[0], 3))
+    disp[:, :gdim] = problem.u.x.array.reshape(-1, gdim)
+    grid.points += disp
+    grid.point_data["contact pressure"] = pressure.x.array.copy()
+    plotter = pyvista.Plotter(off_screen=True, window_size=(1200, 800))
+    plotter.add_mesh(
+        grid, scalars="contact pressure", cmap="inferno_r", show_edges=gdim == 2,
+        edge_color="#777777", scalar_bar_args={"title": "contact pressure -lam"},
+    )
+    bounds = np.array(grid.bounds).reshape(3, 2).T
+    plotter.add_mesh(
+        _obstacle_mesh(problem, bounds), color="#555555", line_width=3,
+        opacity=1.0 if gdim == 2 else 0.25,
+    )
+    if gdim == 2:
+        plotter.view_xy()
+        plotter.camera.parallel_projection = True
+    else:  # from below and aside, where the contact is usually seen
+        plotter.view_vector((1.0, -1.3, -0.8), viewup=(0.0, 0.0, 1.0))
+    pad = 0.1 * float(np.max(bounds[1] - bounds[0]))
+    lo, hi = bounds[0] - pad, bounds[1] + pad
+    plotter.reset_camera(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]))
+    if title:
+        plotter.add_text(title, font_size=12)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    plotter.screenshot(str(path))
+    plotter.close()

@@ -1,0 +1,186 @@
+"""Turn a validated :class:`~fenics_contact.scene.Scene` into a contact problem.
+
+Builds the mesh (gmsh .geo/.msh or a generator), resolves facet tags by
+number or physical name, and creates only what the scene declares. Tag and
+dimension mistakes that need the mesh to be seen are reported here, still
+before any form is compiled.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from dolfinx import mesh
+from mpi4py import MPI
+
+from fenics_contact.contact import ContactSettings
+from fenics_contact.materials import material
+from fenics_contact.obstacles import RigidBall, RigidObstacle, RigidPlane
+from fenics_contact.problem import ContactProblem, PrescribedDisplacement, SurfaceTraction
+from fenics_contact.scene import GENERATOR_TAGS, BoundarySpec, Scene, SceneError
+
+
+@dataclass
+class BodyMesh:
+    """A mesh with its facet tags and the names of its physical groups."""
+
+    domain: mesh.Mesh
+    facet_tags: mesh.MeshTags
+    names: dict[str, int]
+
+
+def _generated(scene: Scene, comm: MPI.Comm) -> BodyMesh:
+    spec = scene.mesh
+    lo = np.array(spec.origin, dtype=float)
+    hi = lo + np.array(spec.size, dtype=float)
+    if spec.generator == "rectangle":
+        cell = mesh.CellType.quadrilateral if spec.cell == "quadrilateral" else mesh.CellType.triangle
+        domain = mesh.create_rectangle(comm, [lo, hi], list(spec.cells), cell)
+    else:
+        cell = mesh.CellType.hexahedron if spec.cell == "hexahedron" else mesh.CellType.tetrahedron
+        domain = mesh.create_box(comm, [lo, hi], list(spec.cells), cell)
+    names = GENERATOR_TAGS[spec.generator]  # type: ignore[index]
+    fdim = domain.topology.dim - 1
+    facets, values = [], []
+    for axis in range(domain.topology.dim):
+        for side, coordinate in enumerate((lo[axis], hi[axis])):
+            found = mesh.locate_entities_boundary(
+                domain, fdim, lambda x, a=axis, c=coordinate: np.isclose(x[a], c)
+            )
+            facets.append(found)
+            values.append(np.full(found.size, 2 * axis + side + 1, dtype=np.int32))
+    all_facets = np.concatenate(facets)
+    all_values = np.concatenate(values)
+    # a facet on two sides cannot exist; edges shared by sides are not facets in 2D/3D
+    order = np.argsort(all_facets, kind="stable")
+    unique, first = np.unique(all_facets[order], return_index=True)
+    tags = mesh.meshtags(domain, fdim, unique, all_values[order][first])
+    return BodyMesh(domain, tags, dict(names))
+
+
+def _from_gmsh(scene: Scene, comm: MPI.Comm) -> BodyMesh:
+    import gmsh
+    from dolfinx.io import gmsh as gmshio
+
+    spec = scene.mesh
+    assert spec.file is not None
+    started = not gmsh.isInitialized()
+    if started:
+        gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    try:
+        if comm.rank == 0:
+            gmsh.clear()
+            for name, value in spec.parameters.items():
+                gmsh.parser.setNumber(name, [float(value)])
+            gmsh.open(str(spec.file))
+            if spec.file.suffix == ".geo":
+                gmsh.model.mesh.generate(scene.dimension)
+            dims = {d for d, _ in gmsh.model.getPhysicalGroups()}
+            if scene.dimension not in dims:
+                raise SceneError(
+                    f"{scene.path.name}: [scene] dimension = {scene.dimension}, but the mesh "
+                    f"{spec.file.name} has no {scene.dimension}D physical group; set the "
+                    "dimension to the mesh's or add a physical group for the body."
+                )
+        data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=scene.dimension)
+    finally:
+        if started:
+            gmsh.finalize()
+    if data.facet_tags is None:
+        raise SceneError(f"{spec.file}: the mesh has no physical groups on its boundary.")
+    fdim = scene.dimension - 1
+    names = {
+        name: group.tag for name, group in data.physical_groups.items() if group.dim == fdim
+    }
+    return BodyMesh(data.mesh, data.facet_tags, names)
+
+
+def build_mesh(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> BodyMesh:
+    """Create the body mesh the scene asks for."""
+    return _from_gmsh(scene, comm) if scene.mesh.file is not None else _generated(scene, comm)
+
+
+def tagged_facets(body: BodyMesh, scene: Scene, section: str, tag: int | str) -> np.ndarray:
+    """Facets carrying ``tag`` (a number or a physical name); errors name the choices."""
+    number = body.names.get(tag) if isinstance(tag, str) else tag
+    comm = body.domain.comm
+    available = sorted(set(comm.allreduce(body.facet_tags.values.tolist(), op=MPI.SUM)))
+    named = ", ".join(f"{n} = {t}" for n, t in sorted(body.names.items(), key=lambda kv: kv[1]))
+    if number is None or number not in available:
+        raise SceneError(
+            f"{scene.path.name}: [{section}] tag = {tag!r} is not a facet tag of the mesh; "
+            f"available: {named or ', '.join(map(str, available))}."
+        )
+    return body.facet_tags.find(number)
+
+
+def _restricted(body: BodyMesh, facets: np.ndarray, spec: BoundarySpec) -> np.ndarray:
+    if not spec.bounds:
+        return facets
+    fdim = body.domain.topology.dim - 1
+    midpoints = mesh.compute_midpoints(body.domain, fdim, facets)
+    keep = np.ones(facets.size, dtype=bool)
+    for axis, (lo, hi) in spec.bounds.items():
+        tol = 1e-10 * max(1.0, abs(lo), abs(hi))
+        keep &= (midpoints[:, axis] >= lo - tol) & (midpoints[:, axis] <= hi + tol)
+    return facets[keep]
+
+
+def build_obstacle(scene: Scene, domain: mesh.Mesh) -> RigidObstacle:
+    """The scene's rigid obstacle, placed by dolfinx Constants."""
+    spec = scene.obstacle
+    if spec.type == "plane":
+        return RigidPlane(domain, spec.point, spec.normal)
+    return RigidBall(domain, spec.point, spec.radius, inside=spec.inside)
+
+
+def contact_facets(scene: Scene, body: BodyMesh, obstacle: RigidObstacle) -> np.ndarray:
+    """Candidate contact facets: by tag, or detected along the obstacle's path."""
+    spec = scene.contact
+    if spec.tag is not None:
+        return tagged_facets(body, scene, "contact", spec.tag)
+    from fenics_contact.candidates import detect_candidate_facets
+
+    return detect_candidate_facets(body.domain, obstacle, scene.obstacle.motion, spec.margin)
+
+
+def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProblem:
+    """Mesh, material, conditions, obstacle and contact surface of a scene."""
+    body = build_mesh(scene, comm)
+    if body.domain.geometry.dim != scene.dimension:
+        raise SceneError(
+            f"{scene.path.name}: [scene] dimension = {scene.dimension} but the mesh is "
+            f"{body.domain.geometry.dim}D."
+        )
+    prescribed = []
+    for i, spec in enumerate(scene.dirichlet):
+        facets = _restricted(body, tagged_facets(body, scene, f"dirichlet {i + 1}", spec.tag), spec)
+        if comm.allreduce(facets.size, op=MPI.SUM) == 0:
+            raise SceneError(
+                f"{scene.path.name}: [[dirichlet]] {i + 1} selects no facet; widen its bounds."
+            )
+        prescribed.append(PrescribedDisplacement(facets, spec.value))
+    tractions = [
+        SurfaceTraction(
+            _restricted(body, tagged_facets(body, scene, f"traction {i + 1}", spec.tag), spec),
+            tuple(float(v) for v in spec.value if v is not None),
+        )
+        for i, spec in enumerate(scene.tractions)
+    ]
+    obstacle = build_obstacle(scene, body.domain)
+    settings = ContactSettings(
+        r=scene.contact.r, relative=scene.contact.relative,
+        quadrature=scene.contact.quadrature,  # type: ignore[arg-type]
+    )
+    return ContactProblem(
+        body.domain,
+        material(scene.law, scene.E, scene.nu),
+        obstacle,
+        contact_facets(scene, body, obstacle),
+        settings,
+        prescribed=prescribed,
+        tractions=tractions,
+        obstacle_motion=scene.obstacle.motion,
+    )
