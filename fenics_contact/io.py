@@ -6,11 +6,13 @@ so a run that fails later keeps the steps already done.
 
 from __future__ import annotations
 
+import copy
 import csv
 import json
 import math
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
+from xml.etree import ElementTree
 
 import numpy as np
 from dolfinx import fem, io
@@ -78,6 +80,52 @@ class SurfaceToBody:
         return f
 
 
+def flatten_xdmf(path: Path) -> None:
+    """Rewrite a DOLFINx XDMF file as one temporal collection with every field per step.
+
+    DOLFINx writes one collection per function and shares the mesh through
+    ``xi:include``; some readers (VTK's legacy XDMF reader, meshio) cannot
+    follow that. The rewritten file keeps the same HDF5 datasets, copies the
+    mesh's Topology and Geometry into every step and groups all attributes of
+    a time value in one grid, which ParaView shows as one dataset with all
+    fields. Safe to call repeatedly: the input is always DOLFINx's layout.
+    """
+    tree = ElementTree.parse(path)
+    domain = tree.getroot().find("Domain")
+    if domain is None:
+        return
+    grids = domain.findall("Grid")
+    mesh_grid = next((g for g in grids if g.get("GridType") == "Uniform"), None)
+    if mesh_grid is None:
+        return
+    shared = [c for c in mesh_grid if c.tag in ("Topology", "Geometry")]
+    steps: dict[str, list[ElementTree.Element]] = {}
+    for collection in (g for g in grids if g.get("CollectionType") == "Temporal"):
+        for grid in collection.findall("Grid"):
+            time = grid.find("Time")
+            if time is None:
+                continue
+            steps.setdefault(time.get("Value", "0"), []).extend(grid.findall("Attribute"))
+    if not steps:
+        return
+    for g in grids:
+        domain.remove(g)
+    series = ElementTree.SubElement(
+        domain, "Grid", Name="solution", GridType="Collection", CollectionType="Temporal"
+    )
+    for value in sorted(steps, key=float):
+        grid = ElementTree.SubElement(series, "Grid", Name="solution", GridType="Uniform")
+        for element in shared:
+            grid.append(copy.deepcopy(element))
+        ElementTree.SubElement(grid, "Time", Value=value)
+        for attribute in steps[value]:
+            grid.append(attribute)
+    ElementTree.indent(tree)
+    tmp = path.with_suffix(".xdmf.tmp")
+    tree.write(tmp, xml_declaration=True, encoding="utf-8")
+    tmp.replace(path)
+
+
 class StepWriter:
     """Writes the chosen fields at every load step into one XDMF file (with its .h5).
 
@@ -135,7 +183,15 @@ class StepWriter:
                 self.file.write_function(self._stress, t)
             else:
                 self.file.write_function(self._surface_field(name, surface[name]), t)
+        self._flatten()
+
+    def _flatten(self) -> None:
+        self.problem.comm.Barrier()
+        if self.problem.comm.rank == 0:
+            flatten_xdmf(self.path)
+        self.problem.comm.Barrier()
 
     def close(self) -> None:
         """Close the file."""
         self.file.close()
+        self._flatten()

@@ -1,0 +1,85 @@
+"""`fenics-contact run` on shipped scenes: files on disk, XDMF read back with VTK."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+from fenics_contact.cli import main
+from fenics_contact.runner import run_scene
+from fenics_contact.scene import load_scene
+
+SCENES = Path(__file__).parent.parent / "scenes"
+FIELDS = {"displacement", "contact_pressure", "gap", "active"}
+
+
+def read_xdmf(path):
+    """All time steps of an XDMF file through VTK's XDMF reader (via PyVista)."""
+    import pyvista
+
+    reader = pyvista.XdmfReader(str(path))
+    steps = []
+    for t in reader.time_values:
+        reader.set_active_time_value(t)
+        steps.append((t, reader.read()))
+    return steps
+
+
+@pytest.mark.parametrize("name", ["paper_ex1", "paper_ex2", "hertz_cylinder", "block_3d"])
+def test_every_shipped_scene_runs_and_writes_xdmf_json_and_pictures(tmp_path, name):
+    out = tmp_path / name
+    assert main(["run", str(SCENES / f"{name}.toml"), "--out", str(out), "--quiet"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "converged"
+    assert summary["steps_completed"] == summary["load_steps"] == len(summary["steps"])
+    for png in ("deformed.png", "residuals.png"):
+        assert (out / png).stat().st_size > 5_000
+    steps = read_xdmf(out / "solution.xdmf")
+    assert len(steps) == summary["load_steps"]
+    assert [t for t, _ in steps] == pytest.approx([s["load_factor"] for s in summary["steps"]])
+    last = steps[-1][1]
+    assert FIELDS <= set(last.point_data.keys())
+    assert "von_mises" in last.cell_data.keys()
+    for grid in (g for _, g in steps):
+        for key in grid.array_names:
+            assert np.all(np.isfinite(grid[key]))
+
+
+def test_xdmf_values_match_the_solution(tmp_path):
+    scene = load_scene(SCENES / "paper_ex2.toml")
+    outcome = run_scene(scene, tmp_path, pictures=False, comm=MPI.COMM_SELF)
+    problem = outcome.problem
+    grid = read_xdmf(tmp_path / "solution.xdmf")[-1][1]
+    # match points by coordinates: displacement, pressure and the active set
+    coords = problem.V.tabulate_dof_coordinates()
+    u = problem.u.x.array.reshape(-1, 2)
+    index = {tuple(np.round(p[:2], 9)): i for i, p in enumerate(grid.points)}
+    rows = [index[tuple(np.round(c[:2], 9))] for c in coords]
+    assert np.allclose(grid.point_data["displacement"][rows, :2], u, atol=1e-12)
+    state = problem.contact_state()
+    q_coords = problem.nodal_coordinates()
+    q_rows = [index[tuple(np.round(c[:2], 9))] for c in q_coords]
+    assert np.allclose(grid.point_data["contact_pressure"][q_rows], state.pressure, atol=1e-12)
+    assert np.array_equal(grid.point_data["active"][q_rows] > 0.5, state.active)
+    assert grid.point_data["contact_pressure"].min() == pytest.approx(state.pressure.min())
+    # von Mises is positive wherever the bar is loaded
+    assert grid.cell_data["von_mises"].max() > 1.0
+
+
+def test_failing_run_exits_nonzero_and_keeps_finished_steps(tmp_path, capsys):
+    text = (SCENES / "paper_ex2.toml").read_text()
+    text = text.replace('method = "gnrm"', 'method = "sua"').replace(
+        "max_iterations = 50", "max_iterations = 60\nmax_cutbacks = 0"
+    ).replace("r = 100.0", "r = 10.0")
+    scene = tmp_path / "failing.toml"
+    scene.write_text(text)
+    out = tmp_path / "out"
+    assert main(["run", str(scene), "--out", str(out), "--quiet"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "did not converge" in err[0]
+    summary = json.loads((out / "summary.json").read_text())
+    done = summary["steps_completed"]
+    assert 0 < done < 10
+    assert len(read_xdmf(out / "solution.xdmf")) == done

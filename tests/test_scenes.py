@@ -1,0 +1,96 @@
+"""Scene files: every kind of mistake fails fast with a message naming the key and the fix."""
+
+import re
+from pathlib import Path
+
+import pytest
+
+from fenics_contact.cli import main
+from fenics_contact.scene import SceneError, load_scene
+
+SCENES = Path(__file__).parent.parent / "scenes"
+EX2 = (SCENES / "paper_ex2.toml").read_text()
+
+
+def write(tmp_path, text, name="scene.toml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def edited(old, new, text=EX2):
+    assert old in text, old
+    return text.replace(old, new, 1)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        (edited("law = \"svk\"", "law = \"svk\"\nYoung = 3.0"), r"unknown key 'Young'.*\[material\]"),
+        (edited("r = 100.0", "rr = 100.0"), r"unknown key 'rr'.*Did you mean 'r'\?"),
+        (edited("r = 100.0", "r = 0.0"), r"\[contact\] r = 0.0: must be > 0"),
+        (edited("r = 100.0", "r = -5"), r"\[contact\] r = -5: must be > 0"),
+        (edited("nu = 0.3", "nu = 0.5"), r"\[material\] nu = 0.5: must be < 0.5.*0.4999"),
+        (edited("E = 210.0", "E = -1.0"), r"\[material\] E = -1.0: must be > 0"),
+        (edited("dimension = 2", "dimension = 3"), r"generator.*2D mesh but \[scene\] dimension = 3"),
+        (edited("dimension = 2", "dimension = 4"), r"dimension = 4: use 2 \(plane strain\) or 3"),
+        (edited("value = [0.0, -0.8]", "value = [0.0, -0.8, 0.0]"), r"value.*list of 2 numbers"),
+        (edited('method = "gnrm"', 'method = "newton"'), r"method = 'newton': choose one of"),
+        (edited('law = "svk"', 'law = "rubber"'), r"law = 'rubber': choose one of"),
+        (edited('law = "svk"', 'law = "svk"\nkinematics = "small"'), r"kinematics.*small strain is law = 'linear'"),
+        (edited("steps = 10", "steps = 0"), r"steps = 0: must be an integer >= 1"),
+        (edited('generator = "rectangle"', 'file = "x.msh"\ngenerator = "rectangle"'), r"exactly one of 'file'"),
+        (edited("[obstacle]", "[obstacles]"), r"unknown key 'obstacles'.*Did you mean 'obstacle'\?"),
+        (edited('tag = "bottom"', 'detect = true\ntag = "bottom"'), r"either 'tag'.*or 'detect = true'"),
+        (EX2 + "\n[contact\n", r"not valid TOML"),
+    ],
+)
+def test_bad_scene_is_rejected_with_key_value_and_fix(tmp_path, text, message):
+    with pytest.raises(SceneError, match=message):
+        load_scene(write(tmp_path, text))
+
+
+def test_missing_mesh_file_is_named(tmp_path):
+    text = edited('generator = "rectangle"   # tags: left 1, right 2, bottom 3, top 4',
+                  'file = "meshes/no_such_mesh.msh"')
+    text = re.sub(r"origin = .*\nsize = .*\ncells = .*\n", "", text)
+    with pytest.raises(SceneError, match=r"\[mesh\] file.*no such mesh file"):
+        load_scene(write(tmp_path, text))
+
+
+def test_missing_scene_file():
+    with pytest.raises(SceneError, match="does not exist"):
+        load_scene("no/such/scene.toml")
+
+
+def test_missing_tag_fails_before_any_form_is_compiled(tmp_path, capsys):
+    path = write(tmp_path, edited('tag = "bottom"', 'tag = "underside"'))
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert "[contact] tag = 'underside' is not a facet tag" in err
+    assert "bottom = 3" in err  # the available names are listed
+    assert not out.exists()
+
+
+def test_wrong_dimension_of_a_gmsh_mesh_is_reported(tmp_path):
+    from fenics_contact.scene_build import build_problem
+
+    text = (SCENES / "hertz_cylinder.toml").read_text()
+    text = text.replace("dimension = 2", "dimension = 3").replace(
+        "value = [0.0, -0.01]", "value = [0.0, -0.01, 0.0]"
+    ).replace("normal = [0.0, 1.0]", "normal = [0.0, 1.0, 0.0]").replace(
+        "point = [0.0, 0.0]", "point = [0.0, 0.0, 0.0]"
+    ).replace('file = "../meshes/', f'file = "{SCENES.parent}/meshes/')
+    scene = load_scene(write(tmp_path, text))
+    with pytest.raises(SceneError, match=r"dimension = 3.*no 3D physical group"):
+        build_problem(scene)
+
+
+def test_shipped_scenes_are_valid():
+    names = set()
+    for path in sorted(SCENES.glob("*.toml")):
+        scene = load_scene(path)
+        names.add(scene.name)
+    assert {"paper-ex1", "paper-ex2", "hertz-cylinder", "block-3d"} <= names
