@@ -7,7 +7,7 @@ BIN     := $(VENV)/bin
 MPIEXEC ?= $(shell [ -x $(BIN)/mpiexec ] && echo $(BIN)/mpiexec || echo mpiexec)
 OUT     ?= results
 
-.PHONY: demo test test-serial test-mpi venv clean
+.PHONY: demo test test-serial test-mpi venv meshes lint clean
 
 venv: $(VENV)/.installed
 
@@ -30,6 +30,14 @@ test-serial: venv
 # Tests marked `mpi` again on two processes.
 test-mpi: venv
 	$(MPIEXEC) -n 2 $(BIN)/python -m pytest -q -m mpi -p no:cacheprovider
+
+# .msh files from every meshes/*.geo (physical groups kept).
+meshes: venv
+	$(BIN)/fenics-contact mesh
+
+lint: venv
+	$(BIN)/python -m pip install --quiet ruff
+	$(BIN)/ruff check fenics_contact tests demos benchmarks
 
 clean:
 	rm -rf $(VENV) $(OUT) .pytest_cache
