@@ -83,3 +83,21 @@ def test_failing_run_exits_nonzero_and_keeps_finished_steps(tmp_path, capsys):
     done = summary["steps_completed"]
     assert 0 < done < 10
     assert len(read_xdmf(out / "solution.xdmf")) == done
+
+
+def test_demo_scene_files_describe_the_demo_problems(tmp_path):
+    """scenes/paper_ex2.toml and the BarOnCradle builder of the demo give one answer."""
+    from fenics_contact.contact import ContactSettings
+    from fenics_contact.diagnostics import SolverSettings
+    from fenics_contact.examples import BarOnCradle
+    from fenics_contact.solvers import make_strategy
+    from fenics_contact.solvers.stepping import solve_load_path
+
+    outcome = run_scene(load_scene(SCENES / "paper_ex2.toml"), tmp_path, pictures=False)
+    example = BarOnCradle()
+    problem = example.build(ContactSettings(r=100.0, relative=False))
+    path = solve_load_path(make_strategy("gnrm", problem, SolverSettings()), example.steps)
+    assert [s.iterations for s in outcome.path.steps] == [s.iterations for s in path.steps]
+    assert outcome.path.steps[-1].contact_force == pytest.approx(
+        path.steps[-1].contact_force, rel=1e-10
+    )
