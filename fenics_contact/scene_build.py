@@ -143,7 +143,11 @@ def contact_facets(scene: Scene, body: BodyMesh, obstacle: RigidObstacle) -> np.
         return tagged_facets(body, scene, "contact", spec.tag)
     from fenics_contact.candidates import detect_candidate_facets
 
-    return detect_candidate_facets(body.domain, obstacle, scene.obstacle.motion, spec.margin)
+    pushes = [abs(v) for d in scene.dirichlet for v in d.value if v is not None]
+    return detect_candidate_facets(
+        body.domain, obstacle, scene.obstacle.motion, spec.margin,
+        displacement_bound=max(pushes, default=0.0),
+    )
 
 
 def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProblem:

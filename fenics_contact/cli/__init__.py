@@ -10,7 +10,7 @@ from collections.abc import Sequence
 import fenics_contact  # noqa: F401  (imports the DOLFINx wheel first)
 
 #: Subcommand modules, in the order ``--help`` lists them.
-SUBCOMMANDS = ("run", "study", "mesh")
+SUBCOMMANDS = ("run", "study", "mesh", "tradeoff", "stability")
 
 
 def build_parser() -> argparse.ArgumentParser:

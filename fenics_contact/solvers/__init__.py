@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from fenics_contact.diagnostics import SolverSettings
 from fenics_contact.problem import ContactProblem
+from fenics_contact.solvers.auto import AutoStrategy
 from fenics_contact.solvers.base import SolveResult, Strategy
 from fenics_contact.solvers.gnrm import GeneralizedNewton
 from fenics_contact.solvers.nua import NestedUzawa
@@ -15,6 +16,7 @@ STRATEGIES: dict[str, type] = {
     "sua": SimultaneousUzawa,
     "nua": NestedUzawa,
     "gnrm": GeneralizedNewton,
+    "auto": AutoStrategy,
 }
 
 #: Names the paper uses in its tables.
@@ -23,6 +25,7 @@ PAPER_NAMES = {
     "sua": "Simultaneous Uzawa",
     "nua": "Nested Uzawa",
     "gnrm": "GNRM",
+    "auto": "Auto",
 }
 
 

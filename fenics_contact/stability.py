@@ -1,0 +1,228 @@
+"""Stability at the extremes: a grid of hard cases, every one ending with a status.
+
+Each case is a scene (:mod:`fenics_contact.bench_scenes`) with one knob at
+an extreme: r from 1e-8 to 1e12 E/h (on the bar and on the Hertz cylinder),
+E from 1e-3 to 1e12 (displacement loading: forces scale with E), nu up to
+0.4999, 1/10/100 load steps, an initial penetration, grazing start, no
+contact, full contact, a very coarse and a fine mesh.
+
+The stopping test is the same for every method and meaningful for any E:
+atol = max(force_rtol * E h^(d-1), round-off floor at r)
+(:func:`fenics_contact.scaling.scaled_atol`). A run never raises: an
+exception becomes the status ``error`` with its message, and non-finite
+outputs the status ``nonfinite``. The step records of every run are written
+to ``<out>/cases/<case>__<method>.json`` after each converged step, so a
+failed step keeps the completed ones on disk.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import traceback
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from mpi4py import MPI
+
+from fenics_contact.bench_scenes import BarScene, BlockScene, HertzScene
+from fenics_contact.contact import ContactSettings
+from fenics_contact.diagnostics import SolverSettings
+from fenics_contact.io import write_json
+from fenics_contact.scaling import DEFAULT_FORCE_RTOL, scaled_atol
+from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.base import SolveResult
+from fenics_contact.solvers.stepping import StepRecord, solve_load_path
+
+#: Methods the stability grid runs by default.
+METHODS = ("penalty", "sua", "nua", "gnrm", "auto")
+
+#: Extra statuses of a run besides the solver statuses.
+ERROR = "error"
+NONFINITE = "nonfinite"
+
+
+@dataclass(frozen=True)
+class StabilityCase:
+    """One extreme: a scene, r relative to E/h and the number of load steps."""
+
+    name: str
+    group: str
+    scene: object
+    r: float = 1.0
+
+    @property
+    def steps(self) -> int:
+        """Load steps of the scene."""
+        return int(self.scene.steps)
+
+
+def full_grid() -> list[StabilityCase]:
+    """Every case of the stability study."""
+    cases = [
+        StabilityCase(f"{name}-r1e{e}", "r", scene, 10.0**e)
+        for name, scene in (("bar", BarScene()), ("hertz", HertzScene()))
+        for e in range(-8, 13, 2)
+    ]
+    cases += [StabilityCase(f"bar-E1e{e}", "E", BarScene(E=10.0**e)) for e in (-3, 0, 3, 6, 9, 12)]
+    cases += [
+        StabilityCase(f"bar-nu{nu:g}", "nu", BarScene(nu=nu)) for nu in (0.0, 0.3, 0.49, 0.4999)
+    ]
+    cases += [StabilityCase(f"bar-steps{n}", "steps", BarScene(steps=n)) for n in (1, 10, 100)]
+    cases += [
+        StabilityCase("bar-penetrating", "start", BarScene(end_gap=-0.02)),
+        StabilityCase("bar-grazing", "start", BarScene(end_gap=0.0)),
+        StabilityCase("hertz-grazing", "start", HertzScene()),
+        StabilityCase("bar-no-contact", "start", BarScene(end_gap=1.0)),
+        StabilityCase("block-full-contact", "start", BlockScene()),
+        StabilityCase("bar-coarse-3x1", "mesh", BarScene(nx=3, ny=1)),
+        StabilityCase("bar-fine-48x16", "mesh", BarScene(nx=48, ny=16, law="neo-hookean")),
+        StabilityCase("bar-fine-48x16-svk", "mesh", BarScene(nx=48, ny=16)),
+    ]
+    return cases
+
+
+def select(cases: Sequence[StabilityCase], names: Sequence[str] | None) -> list[StabilityCase]:
+    """Cases whose name or group is in ``names`` (all when None)."""
+    if not names:
+        return list(cases)
+    wanted = set(names)
+    chosen = [c for c in cases if c.name in wanted or c.group in wanted]
+    known = {c.name for c in cases} | {c.group for c in cases}
+    unknown = sorted(wanted - known)
+    if unknown:
+        raise ValueError(
+            f"Unknown stability case(s) {', '.join(unknown)}; groups: "
+            f"{', '.join(sorted({c.group for c in cases}))}; e.g. {cases[0].name}."
+        )
+    return chosen
+
+
+@dataclass
+class CaseRecord:
+    """Outcome of one (case, method) run; every number finite."""
+
+    case: str
+    group: str
+    method: str
+    status: str
+    r_relative: float
+    r_absolute: float
+    E: float
+    nu: float
+    load_steps: int
+    steps_completed: int
+    iterations: int
+    linear_solves: int
+    updates: int
+    cutbacks: int
+    max_penetration: float
+    contact_force: float
+    max_abs_u: float
+    atol: float
+    wall_s: float
+    switches: int = 0
+    switch_log: list[str] = field(default_factory=list)
+    message: str = ""
+
+    def row(self) -> dict[str, object]:
+        """Flat CSV row (the switch log shortened to its distinct kinds)."""
+        d = asdict(self)
+        kinds = dict.fromkeys(s.split(":")[0] for s in self.switch_log)
+        d["switch_log"] = "; ".join(kinds)
+        return d
+
+
+def _finite(*values: float) -> bool:
+    return all(math.isfinite(v) for v in values)
+
+
+def run_case(
+    case: StabilityCase,
+    method: str,
+    *,
+    max_iterations: int = 100,
+    max_cutbacks: int = 0,
+    force_rtol: float = DEFAULT_FORCE_RTOL,
+    out: Path | None = None,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> CaseRecord:
+    """Run one method on one case; never raises for a solver or model failure."""
+    scene = case.scene
+    record = CaseRecord(
+        case=case.name, group=case.group, method=method, status=ERROR, r_relative=case.r,
+        r_absolute=0.0, E=float(getattr(scene, "E", 0.0)), nu=float(getattr(scene, "nu", 0.0)),
+        load_steps=case.steps, steps_completed=0, iterations=0, linear_solves=0, updates=0,
+        cutbacks=0, max_penetration=0.0, contact_force=0.0, max_abs_u=0.0, atol=0.0, wall_s=0.0,
+    )
+    steps_file = None if out is None else out / "cases" / f"{case.name}__{method}.json"
+    done: list[dict] = []
+    start = time.perf_counter()
+    try:
+        problem = scene.build(ContactSettings(r=case.r, relative=True), comm)
+        record.r_absolute = problem.r_absolute
+        record.atol = scaled_atol(problem, force_rtol)
+        settings = SolverSettings(atol=record.atol, max_iterations=max_iterations)
+        strategy = make_strategy(method, problem, settings)
+
+        def keep(step: StepRecord) -> None:
+            done.append(step.to_dict())
+            if steps_file is not None:
+                write_json(steps_file, {"case": case.name, "method": method, "steps": done})
+
+        def note(_: StepRecord, result: SolveResult) -> None:
+            record.switch_log.extend(result.switches)
+
+        path = solve_load_path(
+            strategy, case.steps, max_cutbacks=max_cutbacks, on_step=keep, on_iteration=note
+        )
+        state = problem.contact_state()
+        local_u = float(np.max(np.abs(problem.u.x.array), initial=0.0))
+        record.max_abs_u = comm.allreduce(local_u, op=MPI.MAX)
+        record.status = path.status
+        record.iterations = path.iterations
+        record.linear_solves = path.linear_solves
+        record.updates = path.updates
+        record.cutbacks = sum(s.cutbacks for s in path.steps)
+        record.steps_completed = len(done)
+        record.max_penetration = state.max_penetration
+        record.contact_force = state.contact_force
+        record.switches = len(record.switch_log)
+        if not _finite(record.max_abs_u, state.max_penetration, state.contact_force):
+            record.status = NONFINITE
+            record.max_abs_u = record.max_penetration = record.contact_force = 0.0
+    except Exception as exc:
+        record.status = ERROR
+        record.message = f"{type(exc).__name__}: {exc}".splitlines()[0][:200]
+        record.steps_completed = len(done)
+        if comm.rank == 0:
+            traceback.print_exc()
+    record.wall_s = time.perf_counter() - start
+    if steps_file is not None:
+        write_json(
+            steps_file,
+            {"case": case.name, "method": method, "status": record.status, "steps": done},
+        )
+    return record
+
+
+def run_grid(
+    cases: Sequence[StabilityCase],
+    methods: Sequence[str],
+    *,
+    out: Path | None = None,
+    progress: Callable[[CaseRecord], None] | None = None,
+    **options: float,
+) -> list[CaseRecord]:
+    """Run every method on every case; ``options`` go to :func:`run_case`."""
+    records = []
+    for case in cases:
+        for method in methods:
+            record = run_case(case, method, out=out, **options)
+            records.append(record)
+            if progress is not None:
+                progress(record)
+    return records

@@ -1,0 +1,116 @@
+"""The auto strategy: converges where plain GNRM fails, costs what GNRM costs where it works."""
+
+import numpy as np
+import pytest
+
+from mpi4py import MPI
+
+from fenics_contact.bench_scenes import BarScene, HertzScene
+from fenics_contact.contact import ContactSettings
+from fenics_contact.diagnostics import SolverSettings, Status
+from fenics_contact.scaling import force_scale, residual_floor, scaled_atol
+from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.auto import AutoStrategy
+from fenics_contact.solvers.stepping import solve_load_path
+
+BAR = BarScene()
+
+
+def solve(scene, method, r, quadrature="nodal", comm=MPI.COMM_WORLD, **settings):
+    problem = scene.build(ContactSettings(r=r, relative=True, quadrature=quadrature), comm)
+    options = {"atol": scaled_atol(problem), "max_iterations": 60, **settings}
+    strategy = make_strategy(method, problem, SolverSettings(**options))
+    switches = []
+    path = solve_load_path(
+        strategy, scene.steps, max_cutbacks=0,
+        on_iteration=lambda _, result: switches.extend(result.switches),
+    )
+    return problem, path, switches
+
+
+@pytest.fixture(scope="module")
+def bar_reference():
+    problem, path, _ = solve(BAR, "gnrm", 1.0)
+    assert path.converged
+    return problem.u.x.array.copy()
+
+
+@pytest.mark.parametrize("r", [1e8, 1e12])
+def test_auto_converges_on_the_bar_where_gnrm_diverges(r, bar_reference):
+    _, gnrm, _ = solve(BAR, "gnrm", r)
+    assert gnrm.status == Status.DIVERGED
+    problem, path, switches = solve(BAR, "auto", r)
+    assert path.converged
+    assert problem.r_relative == pytest.approx(r)  # the user's r is restored
+    assert any(s.startswith("rescale r") for s in switches)
+    scale = np.abs(bar_reference).max()
+    assert np.abs(problem.u.x.array - bar_reference).max() < 1e-9 * scale
+    assert path.steps[-1].max_penetration < 1e-12
+
+
+@pytest.mark.mpi
+def test_auto_converges_on_hertz_at_r_1e10_where_gnrm_diverges():
+    scene = HertzScene(h_contact=0.02)
+    _, gnrm, _ = solve(scene, "gnrm", 1e10)
+    assert gnrm.status == Status.DIVERGED
+    reference, _, _ = solve(scene, "gnrm", 1.0)
+    problem, path, _ = solve(scene, "auto", 1e10)
+    assert path.converged
+    assert np.allclose(problem.lam.x.array, reference.lam.x.array, atol=1e-8 * scene.E)
+
+
+def test_auto_costs_what_gnrm_costs_where_gnrm_works():
+    for r in (1e-2, 1.0, 1e2):
+        _, gnrm, _ = solve(BAR, "gnrm", r)
+        _, auto, switches = solve(BAR, "auto", r)
+        assert gnrm.converged and auto.converged
+        assert auto.iterations == gnrm.iterations
+        assert switches == []
+    _, gnrm, _ = solve(BAR, "gnrm", 1e6)
+    _, auto, _ = solve(BAR, "auto", 1e6)
+    assert gnrm.converged and auto.iterations <= 1.2 * gnrm.iterations
+
+
+def test_line_search_stage_reaches_the_same_answer(bar_reference):
+    problem = BAR.build(ContactSettings(r=1.0), MPI.COMM_WORLD)
+    strategy = AutoStrategy(problem, SolverSettings(atol=scaled_atol(problem)))
+    from fenics_contact.solvers.auto import _Tally
+
+    for k in range(1, BAR.steps + 1):
+        problem.set_load(k / BAR.steps)
+        tally = _Tally()
+        status = strategy._newton(strategy._stage_settings(problem.r_absolute), tally,
+                                  line_search=True)
+        assert status is Status.CONVERGED
+    scale = np.abs(bar_reference).max()
+    assert np.abs(problem.u.x.array - bar_reference).max() < 1e-9 * scale
+
+
+def test_gauss_rule_climbs_to_the_users_r_by_continuation():
+    problem = BAR.build(ContactSettings(r=1e4, quadrature="gauss"), MPI.COMM_WORLD)
+    rungs = AutoStrategy(problem, SolverSettings()).rungs()
+    assert rungs[0] == pytest.approx(1e2 * problem.stiffness_scale)
+    assert rungs[-1] == pytest.approx(problem.r_absolute) and len(rungs) == 2
+    auto, path, switches = solve(BAR, "auto", 1e3, quadrature="gauss")
+    assert path.converged and any(s.startswith("continuation") for s in switches)
+    gnrm = BAR.build(ContactSettings(r=1e3, quadrature="gauss"), MPI.COMM_WORLD)
+    solve_load_path(make_strategy("gnrm", gnrm, SolverSettings(atol=scaled_atol(gnrm),
+                                                                 max_iterations=60)),
+                    BAR.steps, max_cutbacks=4)
+    scale = np.abs(gnrm.u.x.array).max()
+    assert np.abs(auto.u.x.array - gnrm.u.x.array).max() < 1e-8 * scale
+
+
+def test_stopping_test_never_demands_less_than_the_round_off_floor():
+    """At r = 1e10 E/h plain GNRM stalls near eps r g_scale ||A||; with the floor in the
+    tolerance (and no growth test) it stops there instead of running to the limit."""
+    problem = BAR.build(ContactSettings(r=1e10), MPI.COMM_WORLD)
+    floor = residual_floor(problem)
+    assert scaled_atol(problem) == pytest.approx(floor)
+    assert floor > 1e-8 and floor < 1e-3 * force_scale(problem)
+    strict = make_strategy("gnrm", problem, SolverSettings(atol=1e-3 * floor, max_iterations=30,
+                                                           divergence_factor=1e300))
+    path = solve_load_path(strict, BAR.steps, max_cutbacks=0)
+    assert path.status == Status.MAX_ITERATIONS
+    _, path, _ = solve(BAR, "gnrm", 1e10, divergence_factor=1e300)
+    assert path.converged
