@@ -18,6 +18,7 @@ from typing import Literal
 import numpy as np
 import ufl
 from dolfinx import fem, mesh
+
 from mpi4py import MPI
 
 from fenics_contact.petsc_vectors import assemble_local

@@ -139,7 +139,7 @@ class SignoriniReport:
     max_complementarity: float
 
 
-def signorini_report(gap: np.ndarray, pressure: np.ndarray, comm) -> SignoriniReport:  # noqa: ANN001
+def signorini_report(gap: np.ndarray, pressure: np.ndarray, comm) -> SignoriniReport:
     """Global worst violations of g >= 0, lam <= 0, lam g = 0 at the nodes."""
     from mpi4py import MPI
 

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from dolfinx import mesh
+
 from mpi4py import MPI
 
 from fenics_contact.contact import ContactSettings

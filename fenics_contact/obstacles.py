@@ -58,7 +58,7 @@ class RigidPlane(RigidObstacle):
         self.normal = fem.Constant(domain, n / np.linalg.norm(n))
 
     def gap(self, x: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
-        """g = (x - x0) . n."""
+        """G = (x - x0) . n."""
         return ufl.dot(x - self.point, self.normal)
 
     def gap_value(self, x: np.ndarray) -> np.ndarray:
@@ -87,7 +87,7 @@ class RigidBall(RigidObstacle):
         self.inside = inside
 
     def gap(self, x: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
-        """g = +-(|x - c| - R)."""
+        """G = +-(|x - c| - R)."""
         distance = ufl.sqrt(ufl.dot(x - self.point, x - self.point))
         g = distance - self.radius
         return -g if self.inside else g

@@ -18,7 +18,7 @@ from fenics_contact.obstacles import RigidBall, RigidPlane
 from fenics_contact.problem import ContactProblem
 
 
-def _obstacle_mesh(problem: ContactProblem, bounds: np.ndarray):  # noqa: ANN202
+def _obstacle_mesh(problem: ContactProblem, bounds: np.ndarray):
     import pyvista
 
     obstacle = problem.obstacle

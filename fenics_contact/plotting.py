@@ -8,10 +8,10 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
-from fenics_contact.solvers import PAPER_NAMES  # noqa: E402
-from fenics_contact.study import RunRecord  # noqa: E402
+from fenics_contact.solvers import PAPER_NAMES
+from fenics_contact.study import RunRecord
 
 
 def residual_histories(records: Sequence[RunRecord], path: Path) -> None:

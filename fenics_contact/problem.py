@@ -16,6 +16,7 @@ import numpy as np
 import ufl
 import ufl.algorithms
 from dolfinx import default_scalar_type, fem, mesh
+
 from mpi4py import MPI
 
 from fenics_contact.contact import (
@@ -203,12 +204,12 @@ class ContactProblem:
 
     @property
     def r_absolute(self) -> float:
-        """r in stress per length."""
+        """R in stress per length."""
         return float(self.r.value)
 
     @property
     def r_relative(self) -> float:
-        """r divided by E/h."""
+        """R divided by E/h."""
         return self.r_absolute / self.stiffness_scale
 
     def set_load(self, t: float) -> None:

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from dolfinx import mesh
+
 from mpi4py import MPI
 
 from fenics_contact.contact import ContactSettings
@@ -35,10 +36,10 @@ def _generated(scene: Scene, comm: MPI.Comm) -> BodyMesh:
     lo = np.array(spec.origin, dtype=float)
     hi = lo + np.array(spec.size, dtype=float)
     if spec.generator == "rectangle":
-        cell = mesh.CellType.quadrilateral if spec.cell == "quadrilateral" else mesh.CellType.triangle
+        cell = mesh.CellType[spec.cell]
         domain = mesh.create_rectangle(comm, [lo, hi], list(spec.cells), cell)
     else:
-        cell = mesh.CellType.hexahedron if spec.cell == "hexahedron" else mesh.CellType.tetrahedron
+        cell = mesh.CellType[spec.cell]
         domain = mesh.create_box(comm, [lo, hi], list(spec.cells), cell)
     names = GENERATOR_TAGS[spec.generator]  # type: ignore[index]
     fdim = domain.topology.dim - 1

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import ufl
 from dolfinx import fem
+
 from mpi4py import MPI
 
 from fenics_contact.contact import ContactSettings, Quadrature

@@ -2,9 +2,11 @@
 
 import gc
 
-import fenics_contact  # noqa: F401  (loads the DOLFINx wheel before dolfinx)
 import pytest
+
 from mpi4py import MPI
+
+import fenics_contact  # noqa: F401  (loads the DOLFINx wheel before dolfinx)
 
 
 @pytest.fixture(autouse=True)

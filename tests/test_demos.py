@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 import pytest
+
 from mpi4py import MPI
 
 DEMOS = Path(__file__).parent.parent / "demos"

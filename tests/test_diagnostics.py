@@ -16,7 +16,8 @@ def feed(monitor, values, states=None):
 
 
 def test_converged_when_below_absolute_or_relative_tolerance():
-    assert feed(ConvergenceMonitor(SolverSettings(atol=1e-8)), [1.0, 1e-3, 1e-9]) == Status.CONVERGED
+    monitor = ConvergenceMonitor(SolverSettings(atol=1e-8))
+    assert feed(monitor, [1.0, 1e-3, 1e-9]) == Status.CONVERGED
     m = ConvergenceMonitor(SolverSettings(atol=1e-20, rtol=1e-6))
     assert feed(m, [100.0, 1e-2, 1e-5]) == Status.CONVERGED
     assert m.iterations == 2

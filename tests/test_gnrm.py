@@ -1,9 +1,11 @@
 """GNRM on the Example 2 analog: Signorini conditions, r-independence, convergence rate."""
 
+import itertools
 import math
 
 import numpy as np
 import pytest
+
 from mpi4py import MPI
 
 from fenics_contact.contact import ContactSettings
@@ -73,7 +75,7 @@ def test_integral_variant_settles_as_r_grows():
         problem, path = solve(r=r, quadrature="gauss", cutbacks=2)
         assert path.converged, (r, path.status)
         solutions.append(problem.u.x.array.copy())
-    steps = [np.abs(b - a).max() for a, b in zip(solutions, solutions[1:], strict=False)]
+    steps = [np.abs(b - a).max() for a, b in itertools.pairwise(solutions)]
     assert steps[0] > steps[1] > steps[2]
 
 

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 import ufl
 from dolfinx import fem, mesh
+
 from mpi4py import MPI
 
 from fenics_contact.contact import (

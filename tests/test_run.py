@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
 from mpi4py import MPI
 
 from fenics_contact.cli import main

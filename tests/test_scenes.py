@@ -23,31 +23,38 @@ def edited(old, new, text=EX2):
     return text.replace(old, new, 1)
 
 
-@pytest.mark.parametrize(
-    ("text", "message"),
-    [
-        (edited("law = \"svk\"", "law = \"svk\"\nYoung = 3.0"), r"unknown key 'Young'.*\[material\]"),
-        (edited("r = 100.0", "rr = 100.0"), r"unknown key 'rr'.*Did you mean 'r'\?"),
-        (edited("r = 100.0", "r = 0.0"), r"\[contact\] r = 0.0: must be > 0"),
-        (edited("r = 100.0", "r = -5"), r"\[contact\] r = -5: must be > 0"),
-        (edited("nu = 0.3", "nu = 0.5"), r"\[material\] nu = 0.5: must be < 0.5.*0.4999"),
-        (edited("E = 210.0", "E = -1.0"), r"\[material\] E = -1.0: must be > 0"),
-        (edited("dimension = 2", "dimension = 3"), r"generator.*2D mesh but \[scene\] dimension = 3"),
-        (edited("dimension = 2", "dimension = 4"), r"dimension = 4: use 2 \(plane strain\) or 3"),
-        (edited("value = [0.0, -0.8]", "value = [0.0, -0.8, 0.0]"), r"value.*list of 2 numbers"),
-        (edited('method = "gnrm"', 'method = "newton"'), r"method = 'newton': choose one of"),
-        (edited('law = "svk"', 'law = "rubber"'), r"law = 'rubber': choose one of"),
-        (edited('law = "svk"', 'law = "svk"\nkinematics = "small"'), r"kinematics.*small strain is law = 'linear'"),
-        (edited("steps = 10", "steps = 0"), r"steps = 0: must be an integer >= 1"),
-        (edited('generator = "rectangle"', 'file = "x.msh"\ngenerator = "rectangle"'), r"exactly one of 'file'"),
-        (edited("[obstacle]", "[obstacles]"), r"unknown key 'obstacles'.*Did you mean 'obstacle'\?"),
-        (edited('tag = "bottom"', 'detect = true\ntag = "bottom"'), r"either 'tag'.*or 'detect = true'"),
-        (EX2 + "\n[contact\n", r"not valid TOML"),
-    ],
-)
-def test_bad_scene_is_rejected_with_key_value_and_fix(tmp_path, text, message):
+# (text to replace in paper_ex2.toml, replacement, expected message)
+MISTAKES = [
+    ('law = "svk"', 'law = "svk"\nYoung = 3.0', r"unknown key 'Young'.*\[material\]"),
+    ("r = 100.0", "rr = 100.0", r"unknown key 'rr'.*Did you mean 'r'\?"),
+    ("r = 100.0", "r = 0.0", r"\[contact\] r = 0.0: must be > 0"),
+    ("r = 100.0", "r = -5", r"\[contact\] r = -5: must be > 0"),
+    ("nu = 0.3", "nu = 0.5", r"\[material\] nu = 0.5: must be < 0.5.*0.4999"),
+    ("E = 210.0", "E = -1.0", r"\[material\] E = -1.0: must be > 0"),
+    ("dimension = 2", "dimension = 3", r"generator.*2D mesh but \[scene\] dimension = 3"),
+    ("dimension = 2", "dimension = 4", r"dimension = 4: use 2 \(plane strain\) or 3"),
+    ("value = [0.0, -0.8]", "value = [0.0, -0.8, 0.0]", r"value.*list of 2 numbers"),
+    ('method = "gnrm"', 'method = "newton"', r"method = 'newton': choose one of"),
+    ('law = "svk"', 'law = "rubber"', r"law = 'rubber': choose one of"),
+    (
+        'law = "svk"', 'law = "svk"\nkinematics = "small"',
+        r"kinematics.*small strain is law = 'linear'",
+    ),
+    ("steps = 10", "steps = 0", r"steps = 0: must be an integer >= 1"),
+    (
+        'generator = "rectangle"', 'file = "x.msh"\ngenerator = "rectangle"',
+        r"exactly one of 'file'",
+    ),
+    ("[obstacle]", "[obstacles]", r"unknown key 'obstacles'.*Did you mean 'obstacle'\?"),
+    ('tag = "bottom"', 'detect = true\ntag = "bottom"', r"either 'tag'.*or 'detect = true'"),
+    ("[solver]", "[contact\n[solver]", r"not valid TOML"),
+]
+
+
+@pytest.mark.parametrize(("old", "new", "message"), MISTAKES)
+def test_bad_scene_is_rejected_with_key_value_and_fix(tmp_path, old, new, message):
     with pytest.raises(SceneError, match=message):
-        load_scene(write(tmp_path, text))
+        load_scene(write(tmp_path, edited(old, new)))
 
 
 def test_missing_mesh_file_is_named(tmp_path):

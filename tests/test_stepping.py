@@ -3,6 +3,7 @@
 import json
 
 import numpy as np
+
 from mpi4py import MPI
 
 from fenics_contact.contact import ContactSettings

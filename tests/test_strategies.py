@@ -5,6 +5,7 @@ import json
 import numpy as np
 import pytest
 from dolfinx import mesh
+
 from mpi4py import MPI
 
 from fenics_contact.cli import main

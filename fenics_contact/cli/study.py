@@ -43,7 +43,7 @@ def _study(args: argparse.Namespace) -> int:
     out: Path = args.out
     settings = SolverSettings(atol=args.tol, max_iterations=args.max_iterations)
 
-    def show(rec) -> None:  # noqa: ANN001
+    def show(rec) -> None:
         print(
             f"  {rec.method:8s} r = {rec.r:<10g} {rec.status:15s} iterations {rec.iterations:4d}"
             f"  updates {rec.updates:4d}  {rec.wall_s:6.2f} s",

@@ -12,6 +12,7 @@ import math
 from collections.abc import Callable
 
 from dolfinx import fem
+
 from mpi4py import MPI
 
 from fenics_contact.diagnostics import SolverSettings
