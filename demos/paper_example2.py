@@ -24,6 +24,8 @@ import argparse
 from pathlib import Path
 
 import fenics_contact  # noqa: F401  (loads the DOLFINx wheel first)
+import numpy as np
+from mpi4py import MPI
 from fenics_contact.contact import ContactSettings
 from fenics_contact.diagnostics import SolverSettings
 from fenics_contact.examples import BarOnCradle
@@ -36,6 +38,13 @@ parser = argparse.ArgumentParser(description=__doc__)
 parser.add_argument("--out", type=Path, default=Path("results/paper-ex2"))
 args = parser.parse_args()
 out: Path = args.out
+
+
+def say(*text: object) -> None:
+    """Print once, on rank 0."""
+    if MPI.COMM_WORLD.rank == 0:
+        print(*text)
+
 
 # %% [markdown]
 # ## One r, step by step
@@ -51,10 +60,12 @@ patterns = []
 
 def report(step) -> None:
     state = problem.contact_state()
-    order = problem.nodal_coordinates()[:, 0].argsort()
-    pattern = "".join("#" if a else "." for a in state.active[order])
+    pieces = problem.comm.allgather((problem.nodal_coordinates()[:, 0], state.active))
+    x = np.concatenate([p[0] for p in pieces])
+    active = np.concatenate([p[1] for p in pieces])
+    pattern = "".join("#" if a else "." for a in active[np.argsort(x)])
     patterns.append(pattern)
-    print(
+    say(
         f"step {step.step:2d}  iterations {step.iterations}  contact {pattern}  "
         f"force {step.contact_force:8.3f}  max penetration {step.max_penetration:.1e}"
     )
@@ -78,23 +89,25 @@ for r in (1.0, 10.0, 100.0, 1000.0, 10000.0):
     records.append(record)
 
 table = paper_table(records)
-print()
-print(table)
-print("\nPer r: status, total iterations, error against the reference, max penetration")
+say()
+say(table)
+say("\nPer r: status, total iterations, error against the reference, max penetration")
 for rec in records:
-    print(
+    say(
         f"  r = {rec.r:<7g} {rec.status}  {rec.iterations:3d}  {rec.error:.1e}  "
         f"{rec.max_penetration:.1e}"
     )
 
-write_json(
-    out / "summary.json",
-    {
-        "example": "paper-ex2 (bar on a cradle)",
-        "method": "gnrm",
-        "contact_patterns": patterns,
-        "runs": [rec.__dict__ for rec in records],
-    },
-)
-(out / "table.md").write_text(table + "\n")
-print(f"\nWrote {out}/summary.json, {out}/table.md and {out}/solution.xdmf (open in ParaView)")
+# One process writes the summary (every rank holds the same records).
+if MPI.COMM_WORLD.rank == 0:
+    write_json(
+        out / "summary.json",
+        {
+            "example": "paper-ex2 (bar on a cradle)",
+            "method": "gnrm",
+            "contact_patterns": patterns,
+            "runs": [rec.__dict__ for rec in records],
+        },
+    )
+    (out / "table.md").write_text(table + "\n")
+say(f"\nWrote {out}/summary.json, {out}/table.md and {out}/solution.xdmf (open in ParaView)")

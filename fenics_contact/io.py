@@ -10,6 +10,7 @@ import copy
 import csv
 import json
 import math
+import os
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from xml.etree import ElementTree
@@ -38,9 +39,14 @@ def _clean(value: object) -> object:
 
 
 def write_json(path: Path, data: object) -> None:
-    """Write ``data`` as indented JSON (parent folders created)."""
+    """Write ``data`` as indented JSON (parent folders created), replacing the file atomically.
+
+    Call it from one process: it knows nothing of MPI.
+    """
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(_clean(data), indent=2) + "\n")
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    tmp.write_text(json.dumps(_clean(data), indent=2) + "\n")
+    tmp.replace(path)
 
 
 def write_csv(path: Path, rows: Iterable[Mapping[str, object]]) -> None:

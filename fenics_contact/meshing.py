@@ -141,3 +141,134 @@ def _build_half_disk(
     gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
     gmsh.option.setNumber("Mesh.Algorithm", 6)  # Frontal-Delaunay
     gmsh.model.mesh.generate(2)
+
+
+#: Physical tag of the symmetry face x = 0 of the sphere octant (facets).
+SYMMETRY_X_TAG = 4
+#: Physical tag of the symmetry face y = 0 of the sphere octant (facets).
+SYMMETRY_Y_TAG = 5
+
+
+def hertz_sphere_octant(
+    comm: MPI.Comm,
+    radius: float = 1.0,
+    h_contact: float = 0.02,
+    h_far: float = 0.25,
+    fine_radius: float | None = None,
+    coarse_radius: float | None = None,
+    *,
+    rank: int = 0,
+    verbosity: int = 0,
+) -> MeshData:
+    """One eighth of a sphere resting on z = 0, graded toward its lowest point (3D).
+
+    The body is {x >= 0, y >= 0, z <= R, x^2 + y^2 + (z - R)^2 <= R^2}: the
+    quarter of the lower hemisphere of the sphere centred at (0, 0, R), which
+    touches the plane z = 0 at the origin (a mesh vertex). P1 tetrahedra have
+    size ``h_contact`` within ``fine_radius`` of the origin, growing linearly
+    to ``h_far`` at ``coarse_radius``. All lengths in the units of ``radius``.
+
+    Physical groups: volume tag 1 (``BODY_TAG``); facets: the flat face
+    z = R tag 2 (``TOP_TAG``), the spherical surface tag 3
+    (``CONTACT_TAG``), the symmetry faces x = 0 tag 4 (``SYMMETRY_X_TAG``)
+    and y = 0 tag 5 (``SYMMETRY_Y_TAG``). ``meshes/sphere.geo`` describes
+    the same model for the gmsh command line.
+
+    Args:
+        comm: communicator the mesh is distributed over.
+        radius: sphere radius R (length).
+        h_contact: element size near the contact point (length).
+        h_far: element size far from it (length).
+        fine_radius: distance from the origin meshed at ``h_contact``; 0.15 R by default.
+        coarse_radius: distance beyond which the size is ``h_far``; 0.6 R by default.
+        rank: the MPI rank that builds the gmsh model.
+        verbosity: gmsh ``General.Verbosity``.
+
+    Returns:
+        The dolfinx ``MeshData`` (``mesh``, ``cell_tags``, ``facet_tags``).
+    """
+    if not radius > 0:
+        raise ValueError(f"The sphere radius must be > 0, got {radius}.")
+    if not 0 < h_contact <= h_far:
+        raise ValueError(
+            f"Element sizes need 0 < h_contact <= h_far, got h_contact={h_contact}, h_far={h_far}."
+        )
+    fine = 0.15 * radius if fine_radius is None else fine_radius
+    coarse = 0.6 * radius if coarse_radius is None else coarse_radius
+    if not 0 <= fine < coarse:
+        raise ValueError(
+            f"Grading radii need 0 <= fine_radius < coarse_radius, got {fine} and {coarse}."
+        )
+
+    import gmsh
+
+    owns_session = False
+    if comm.rank == rank and not gmsh.isInitialized():
+        gmsh.initialize(interruptible=False)
+        owns_session = True
+    try:
+        if comm.rank == rank:
+            _build_sphere_octant(gmsh, radius, h_contact, h_far, fine, coarse, verbosity)
+        data = model_to_mesh(gmsh.model, comm, rank, gdim=3)
+    finally:
+        if comm.rank == rank:
+            if owns_session:
+                gmsh.finalize()
+            else:
+                gmsh.model.remove()
+    return data
+
+
+def _build_sphere_octant(
+    gmsh,  # the gmsh module (imported lazily)
+    radius: float,
+    h_contact: float,
+    h_far: float,
+    fine: float,
+    coarse: float,
+    verbosity: int,
+) -> None:
+    """Create and mesh the sphere-octant model in the current gmsh session."""
+    gmsh.option.setNumber("General.Verbosity", verbosity)
+    gmsh.model.add("hertz_sphere_octant")
+    occ = gmsh.model.occ
+    R = radius
+    ball = occ.addSphere(0.0, 0.0, R, R)
+    box = occ.addBox(0.0, 0.0, 0.0, R, R, R)
+    (body, *_), _ = occ.intersect([(3, ball)], [(3, box)])
+    occ.synchronize()
+    groups: dict[int, list[int]] = {TOP_TAG: [], CONTACT_TAG: [], SYMMETRY_X_TAG: [],
+                                    SYMMETRY_Y_TAG: []}
+    tol = 1e-6 * R
+    for dim, tag in gmsh.model.getBoundary([body], oriented=False):
+        xmin, ymin, zmin, xmax, ymax, zmax = gmsh.model.getBoundingBox(dim, tag)
+        if zmax - zmin < tol and abs(zmin - R) < tol:
+            groups[TOP_TAG].append(tag)
+        elif xmax - xmin < tol and abs(xmin) < tol:
+            groups[SYMMETRY_X_TAG].append(tag)
+        elif ymax - ymin < tol and abs(ymin) < tol:
+            groups[SYMMETRY_Y_TAG].append(tag)
+        else:
+            groups[CONTACT_TAG].append(tag)
+    gmsh.model.addPhysicalGroup(3, [body[1]], BODY_TAG, name="body")
+    names = {TOP_TAG: "top", CONTACT_TAG: "contact", SYMMETRY_X_TAG: "symmetry_x",
+             SYMMETRY_Y_TAG: "symmetry_y"}
+    for tag, surfaces in groups.items():
+        gmsh.model.addPhysicalGroup(2, surfaces, tag, name=names[tag])
+
+    lowest = [tag for dim, tag in gmsh.model.getEntities(0)
+              if max(abs(c) for c in gmsh.model.getValue(0, tag, [])) < tol]
+    field = gmsh.model.mesh.field
+    distance = field.add("Distance")
+    field.setNumbers(distance, "PointsList", lowest)
+    threshold = field.add("Threshold")
+    field.setNumber(threshold, "InField", distance)
+    field.setNumber(threshold, "SizeMin", h_contact)
+    field.setNumber(threshold, "SizeMax", h_far)
+    field.setNumber(threshold, "DistMin", fine)
+    field.setNumber(threshold, "DistMax", coarse)
+    field.setAsBackgroundMesh(threshold)
+    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+    gmsh.model.mesh.generate(3)

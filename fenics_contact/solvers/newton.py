@@ -2,8 +2,12 @@
 
 A :class:`NewtonKernel` compiles one :class:`VariationalSystem` (residual
 blocks and their ``ufl.derivative`` Jacobian), assembles them into blocked
-PETSc objects and takes Newton steps with a direct solver (MUMPS). It knows
-nothing of contact; strategies decide when to update, stop or cut back.
+PETSc objects and takes Newton steps with a configurable linear solver
+(:mod:`fenics_contact.solvers.linear`: MUMPS by default, or GMRES with a
+Schur field split and algebraic multigrid). It knows nothing of contact;
+strategies decide when to update, stop or cut back. Its
+:class:`~fenics_contact.solvers.timing.KernelTimings` split the time spent
+into compilation, assembly and linear solves.
 """
 
 from __future__ import annotations
@@ -17,6 +21,8 @@ from dolfinx.fem import petsc as fem_petsc
 from petsc4py import PETSc
 
 from fenics_contact.problem import VariationalSystem
+from fenics_contact.solvers.linear import LinearSolverSettings, configure_ksp
+from fenics_contact.solvers.timing import KernelTimings, stopwatch
 
 _prefix_counter = itertools.count()
 
@@ -27,34 +33,54 @@ class NewtonKernel:
     Counts linear solves; the residual norm is the Euclidean norm of the
     assembled residual (Dirichlet rows hold x - x_D), i.e. the discrete L2
     norm of the static out-of-balance force.
+
+    Args:
+        system: residual blocks, unknowns and boundary conditions.
+        linear_solver: LU package of the default direct solver (kept for
+            backward compatibility; ``linear`` overrides it).
+        linear: linear solver settings; direct LU with ``linear_solver`` when None.
     """
 
-    def __init__(self, system: VariationalSystem, linear_solver: str = "mumps") -> None:
+    def __init__(
+        self,
+        system: VariationalSystem,
+        linear_solver: str = "mumps",
+        linear: LinearSolverSettings | None = None,
+    ) -> None:
+        self.timings = KernelTimings()
         self.system = system
         self.unknowns = system.unknowns
         self.bcs = system.bcs
-        self.F = fem.form(system.residuals, entity_maps=system.entity_maps)
-        jacobian = fem.forms.derivative_block(system.residuals, system.unknowns)
-        self.J = fem.form(jacobian, entity_maps=system.entity_maps)
-        self.A = fem_petsc.create_matrix(self.J, kind="mpi")
-        spaces = [u.function_space for u in self.unknowns]
-        self.b = fem_petsc.create_vector(spaces, kind="mpi")
-        self.x = fem_petsc.create_vector(spaces, kind="mpi")
-        self.dx = fem_petsc.create_vector(spaces, kind="mpi")
+        with stopwatch(self.timings, "compile_s"):
+            self.F = fem.form(system.residuals, entity_maps=system.entity_maps)
+            jacobian = fem.forms.derivative_block(system.residuals, system.unknowns)
+            self.J = fem.form(jacobian, entity_maps=system.entity_maps)
+            self.A = fem_petsc.create_matrix(self.J, kind="mpi")
+            self.spaces = [u.function_space for u in self.unknowns]
+            self.b = fem_petsc.create_vector(self.spaces, kind="mpi")
+            self.x = fem_petsc.create_vector(self.spaces, kind="mpi")
+            self.dx = fem_petsc.create_vector(self.spaces, kind="mpi")
         self._blocks = self.b.getAttr("_blocks")
-        prefix = f"fc_{system.name}_{next(_prefix_counter)}_"
-        self.ksp = PETSc.KSP().create(self.A.comm)
-        self.ksp.setOptionsPrefix(prefix)
-        self.ksp.setOperators(self.A)
-        self.ksp.setType("preonly")
-        pc = self.ksp.getPC()
-        pc.setType("lu")
-        pc.setFactorSolverType(linear_solver)
-        self.A.setOptionsPrefix(f"{prefix}A_")
-        self.ksp.setFromOptions()
+        self._prefix = f"fc_{system.name}_{next(_prefix_counter)}_"
+        self.A.setOptionsPrefix(f"{self._prefix}A_")
+        self.ksp: PETSc.KSP | None = None
+        self._keep: tuple = ()
+        self.set_linear_solver(linear or LinearSolverSettings(factor=linear_solver))
         self.linear_solves = 0
         self.residual_norm = np.inf
 
+    # -- linear solver -------------------------------------------------------
+    def set_linear_solver(self, settings: LinearSolverSettings) -> None:
+        """(Re)create the linear solver; the matrix and vectors are kept."""
+        if self.ksp is not None:
+            self.ksp.destroy()
+        self.linear = settings
+        self.ksp = PETSc.KSP().create(self.A.comm)
+        self.ksp.setOptionsPrefix(self._prefix)
+        self.ksp.setOperators(self.A)
+        self._keep = configure_ksp(self.ksp, self.A, self.spaces, settings)
+
+    # -- state transfer --------------------------------------------------------
     def _pull(self) -> None:
         """Copy the unknown Functions into the work vector x."""
         fem_petsc.assign(self.unknowns, self.x)
@@ -65,25 +91,26 @@ class NewtonKernel:
         for u in self.unknowns:
             u.x.scatter_forward()
 
+    # -- Newton ------------------------------------------------------------------
     def assemble_residual(self) -> float:
         """Assemble F at the current unknowns; return and store its norm."""
-        self._pull()
-        fem_petsc.assemble_residual(
-            None, self.x, self.b, self.unknowns, self.F, self.J, self.bcs, self._blocks
-        )
-        self.residual_norm = float(self.b.norm())
+        with stopwatch(self.timings, "residual_s"):
+            self._pull()
+            fem_petsc.assemble_residual(
+                None, self.x, self.b, self.unknowns, self.F, self.J, self.bcs, self._blocks
+            )
+            self.residual_norm = float(self.b.norm())
+        self.timings.residuals += 1
         return self.residual_norm
 
     def block_norms(self) -> list[float]:
         """Norm of each residual block (after :meth:`assemble_residual`)."""
-        offsets = []
         local = self.b.getArray(readonly=True)
         out = []
         start = 0
         for u in self.unknowns:
             im = u.function_space.dofmap.index_map
             n = im.size_local * u.function_space.dofmap.index_map_bs
-            offsets.append((start, start + n))
             out.append(float(np.sum(local[start : start + n] ** 2)))
             start += n
         comm = self.A.comm.tompi4py()
@@ -95,13 +122,23 @@ class NewtonKernel:
         Requires a preceding :meth:`assemble_residual`. Returns False when the
         linear solve fails or produces non-finite values (unknowns untouched).
         """
-        fem_petsc.assemble_jacobian(None, self.x, self.A, None, self.unknowns, self.J, None,
-                                    self.bcs)
+        t = self.timings
+        with stopwatch(t, "jacobian_s"):
+            fem_petsc.assemble_jacobian(
+                None, self.x, self.A, None, self.unknowns, self.J, None, self.bcs
+            )
+        t.jacobians += 1
         try:
-            self.ksp.solve(self.b, self.dx)
+            with stopwatch(t, "setup_s"):
+                self.ksp.setUp()
+                self.ksp.getPC().setUp()
+            with stopwatch(t, "solve_s"):
+                self.ksp.solve(self.b, self.dx)
         except PETSc.Error:
             return False
         self.linear_solves += 1
+        t.linear_solves += 1
+        t.krylov_iterations += self.ksp.getIterationNumber() if self.linear.kind != "direct" else 0
         if self.ksp.getConvergedReason() < 0:
             return False
         if not np.all(np.isfinite(self.dx.getArray(readonly=True))):

@@ -1,0 +1,81 @@
+"""Shared benchmark plumbing: repeats, medians, the time split, JSON and markdown output.
+
+Every figure is the median over repeats (>= 3). Wall time of a solve is
+split into assembly (residual + Jacobian), linear solver (set-up + solve)
+and the rest (Python, diagnostics, stepping), from the Newton kernel's
+:class:`~fenics_contact.solvers.timing.KernelTimings`. Form compilation
+(FFCx JIT; cached on disk after the first run) happens while a problem is
+built and is reported apart as ``build_s``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+import statistics
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+OUT = Path(__file__).resolve().parents[1] / "results" / "bench"
+
+
+def median_dict(runs: Sequence[dict]) -> dict:
+    """Field-wise median of numeric entries over runs; other entries from the first run."""
+    out: dict = {}
+    for key, value in runs[0].items():
+        values = [r[key] for r in runs]
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            out[key] = value
+        else:
+            out[key] = statistics.median(values)
+    return out
+
+
+def split(total_s: float, timings: dict) -> dict[str, float]:
+    """Assembly / linear / rest split of a solve's wall time (seconds)."""
+    assembly = timings["residual_s"] + timings["jacobian_s"]
+    linear = timings["setup_s"] + timings["solve_s"]
+    return {
+        "total_s": total_s,
+        "assembly_s": assembly,
+        "linear_s": linear,
+        "linear_setup_s": timings["setup_s"],
+        "linear_solve_s": timings["solve_s"],
+        "rest_s": total_s - assembly - linear,
+    }
+
+
+def repeat(fn: Callable[[], dict], repeats: int) -> tuple[dict, list[dict]]:
+    """Run ``fn`` ``repeats`` times; return the median record and all records."""
+    runs = [fn() for _ in range(repeats)]
+    return median_dict(runs), runs
+
+
+def machine() -> dict:
+    """What ran the benchmark."""
+    return {
+        "host": platform.node(),
+        "cpus": os.cpu_count(),
+        "python": platform.python_version(),
+        "date": time.strftime("%Y-%m-%d %H:%M:%S"),
+    }
+
+
+def write(name: str, data: dict, table: str, out: Path = OUT) -> None:
+    """Write ``<out>/<name>.json`` and ``<out>/<name>.md``."""
+    out.mkdir(parents=True, exist_ok=True)
+    (out / f"{name}.json").write_text(json.dumps(data, indent=2, default=float) + "\n")
+    (out / f"{name}.md").write_text(table.rstrip() + "\n")
+
+
+def md_table(header: Sequence[str], rows: Sequence[Sequence[object]]) -> str:
+    """A markdown table; floats to 4 significant digits."""
+
+    def cell(v: object) -> str:
+        return f"{v:.4g}" if isinstance(v, float) else str(v)
+
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(cell(v) for v in row) + " |" for row in rows]
+    return "\n".join(lines)

@@ -1,0 +1,76 @@
+"""Run every benchmark in sequence (one process per case) and gather the tables.
+
+``python benchmarks/run_all.py [--quick] [--only hertz2d,cost,compile,hertz3d,ladder,mpi,speedup]``.
+The ladder's large sizes take minutes each; ``--quick`` stops at 1e5 DOFs.
+Serial and 2-rank runs of a size are run one after the other, on a machine
+that others may be using: compare them side by side, not across days.
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+PYTHON = sys.executable
+MPIEXEC = str(Path(PYTHON).parent / "mpiexec")
+
+#: (DOFs, solver, ranks, repeats) of the ladder, in the order they run. The
+#: million-DOF cases and MUMPS beyond 3e4 DOFs run once (minutes each).
+LADDER = [
+    (1e4, "iterative", 1, 3), (3e4, "iterative", 1, 3), (1e5, "iterative", 1, 3),
+    (1e4, "direct", 1, 3), (3e4, "direct", 1, 3),
+    (1e6, "iterative", 1, 1), (1e6, "iterative", 2, 1),
+    (3e5, "iterative", 1, 3), (3e5, "iterative", 2, 3),
+    (1e5, "iterative", 2, 3), (1e5, "direct", 1, 1),
+]
+#: Serial and 2-rank runs of the same size back to back (the speed-up figures).
+SPEEDUP = [(1e5, 3), (1e6, 1)]
+
+
+def call(cmd: list[str]) -> None:
+    """Run one benchmark process, echoing its command."""
+    print("$", " ".join(cmd), flush=True)
+    subprocess.run(cmd, cwd=ROOT, check=False)
+
+
+def ladder_case(dofs: float, solver: str, ranks: int, repeats: int) -> None:
+    """One ladder case in its own process (under mpiexec for ranks > 1)."""
+    cmd = [PYTHON, str(HERE / "ladder3d.py"), "--dofs", f"{dofs:g}", "--solver", solver,
+           "--repeats", str(repeats)]
+    call(([MPIEXEC, "-n", str(ranks)] if ranks > 1 else []) + cmd)
+
+
+def main() -> None:
+    """Command line."""
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--only", default="hertz2d,cost,compile,hertz3d,ladder,mpi,speedup")
+    args = parser.parse_args()
+    parts = set(args.only.split(","))
+    limit = 1e5 if args.quick else 1e6
+    if "hertz2d" in parts:
+        call([PYTHON, str(HERE / "hertz2d.py")])
+    if "cost" in parts:
+        call([PYTHON, str(HERE / "cost_of_contact.py")])
+    if "compile" in parts:
+        call([PYTHON, str(HERE / "compile_cost.py")])
+    if "hertz3d" in parts:
+        call([PYTHON, str(HERE / "hertz3d.py")])
+    for dofs, solver, ranks, repeats in LADDER:
+        wanted = "mpi" in parts if ranks > 1 else "ladder" in parts
+        if wanted and dofs <= limit:
+            ladder_case(dofs, solver, ranks, repeats)
+    for dofs, repeats in SPEEDUP if "speedup" in parts else []:
+        if dofs <= limit:
+            ladder_case(dofs, "iterative", 1, repeats)
+            ladder_case(dofs, "iterative", 2, repeats)
+    if parts & {"ladder", "mpi", "speedup"}:
+        call([PYTHON, str(HERE / "ladder3d.py"), "--table"])
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,144 @@
+"""The 3D Hertz validation problem: one eighth of a sphere pressed on a rigid plane.
+
+:class:`HertzSphere` builds the contact problem on the graded octant of
+:func:`fenics_contact.meshing.hertz_sphere_octant` with symmetry conditions
+on x = 0 and y = 0; :func:`measure_hertz_sphere` compares its converged state
+with :mod:`fenics_contact.hertz3d` at the force it transmits (four times the
+octant's, the model being a quarter of the lower hemisphere).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+from dolfinx import mesh
+
+from mpi4py import MPI
+
+from fenics_contact.contact import ContactSettings
+from fenics_contact.hertz import ContactProfileFit, fit_contact_profile, relative_error
+from fenics_contact.hertz3d import HertzPointContact, hertz_point_contact
+from fenics_contact.materials import Elastic, LinearElastic, NeoHookean
+from fenics_contact.meshing import (
+    CONTACT_TAG,
+    SYMMETRY_X_TAG,
+    SYMMETRY_Y_TAG,
+    TOP_TAG,
+    hertz_sphere_octant,
+)
+from fenics_contact.obstacles import RigidPlane
+from fenics_contact.problem import ContactProblem, PrescribedDisplacement
+
+#: Symmetry copies of the octant in the full lower hemisphere.
+COPIES = 4
+
+
+@dataclass(frozen=True)
+class HertzSphere:
+    """A sphere octant whose flat top z = R is pushed down onto the plane z = 0.
+
+    The top face moves down by ``push`` (its in-plane motion is free); the
+    faces x = 0 and y = 0 carry symmetry conditions. Candidate contact
+    facets are spherical facets with midpoints below ``contact_band * R``.
+
+    Attributes:
+        radius: sphere radius R (length).
+        E: Young's modulus (stress).
+        nu: Poisson's ratio.
+        law: 'linear' (small strain) or 'neo-hookean' (finite strain).
+        push: downward displacement of the top face at load factor 1 (length).
+        h_contact: element size at the contact point (length).
+        h_far: element size away from it (length).
+        fine_radius: distance from the contact point meshed at ``h_contact``.
+        coarse_radius: distance beyond which the size is ``h_far``.
+        contact_band: candidate facets have midpoints with z < contact_band R.
+    """
+
+    radius: float = 1.0
+    E: float = 200.0
+    nu: float = 0.3
+    law: str = "linear"
+    push: float = 0.01
+    h_contact: float = 0.02
+    h_far: float = 0.25
+    fine_radius: float = 0.15
+    coarse_radius: float = 0.6
+    contact_band: float = 0.03
+
+    def material(self) -> Elastic:
+        """The body's law."""
+        laws = {"linear": LinearElastic, "neo-hookean": NeoHookean}
+        return laws[self.law](E=self.E, nu=self.nu)
+
+    def build(self, settings: ContactSettings, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProblem:
+        """Mesh the octant and create the contact problem (load factor 1 = ``push``)."""
+        data = hertz_sphere_octant(
+            comm, radius=self.radius, h_contact=self.h_contact, h_far=self.h_far,
+            fine_radius=self.fine_radius, coarse_radius=self.coarse_radius,
+        )
+        domain, tags = data.mesh, data.facet_tags
+        fdim = domain.topology.dim - 1
+        sphere = tags.find(CONTACT_TAG)
+        midpoints = mesh.compute_midpoints(domain, fdim, sphere)
+        candidates = sphere[midpoints[:, 2] < self.contact_band * self.radius]
+        plane = RigidPlane(domain, point=(0.0, 0.0, 0.0), normal=(0.0, 0.0, 1.0))
+        prescribed = [
+            PrescribedDisplacement(tags.find(TOP_TAG), (None, None, -self.push)),
+            PrescribedDisplacement(tags.find(SYMMETRY_X_TAG), (0.0, None, None)),
+            PrescribedDisplacement(tags.find(SYMMETRY_Y_TAG), (None, 0.0, None)),
+        ]
+        return ContactProblem(
+            domain, self.material(), plane, candidates, settings, prescribed=prescribed
+        )
+
+
+@dataclass(frozen=True)
+class SphereComparison:
+    """The finite element contact state against 3D Hertz theory at the same force.
+
+    Attributes:
+        P: total contact force of the whole sphere (force), measured.
+        hertz: the analytic solution for that force.
+        fit: contact radius and peak from the nodal pressures (radial coordinate).
+        a_error: relative error of the fitted contact radius.
+        p0_error: relative error of the fitted peak pressure.
+        nodal_peak_error: relative error of the largest nodal pressure.
+        max_penetration: largest nodal penetration (length).
+    """
+
+    P: float
+    hertz: HertzPointContact
+    fit: ContactProfileFit
+    a_error: float
+    p0_error: float
+    nodal_peak_error: float
+    max_penetration: float
+
+    def to_dict(self) -> dict:
+        """Plain-data view for JSON."""
+        return asdict(self)
+
+
+def measure_hertz_sphere(problem: ContactProblem, sphere: HertzSphere) -> SphereComparison:
+    """Compare the converged contact state with Hertz theory for its own force.
+
+    The fit of p^2 against r^2 (r the distance from the z axis) uses the
+    nodes in contact on every rank.
+    """
+    state = problem.contact_state()
+    xy = problem.nodal_coordinates()[:, :2]
+    r = np.concatenate(problem.comm.allgather(np.linalg.norm(xy, axis=1)))
+    p = np.concatenate(problem.comm.allgather(state.pressure))
+    fit = fit_contact_profile(r, p)
+    force = COPIES * state.contact_force
+    hertz = hertz_point_contact(force, sphere.radius, sphere.E, sphere.nu)
+    return SphereComparison(
+        P=force,
+        hertz=hertz,
+        fit=fit,
+        a_error=relative_error(fit.a, hertz.a),
+        p0_error=relative_error(fit.p0, hertz.p0),
+        nodal_peak_error=relative_error(fit.nodal_peak, hertz.p0),
+        max_penetration=state.max_penetration,
+    )

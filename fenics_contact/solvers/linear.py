@@ -1,0 +1,203 @@
+"""Linear solvers for the Newton kernel: direct (MUMPS) or Krylov with block preconditioning.
+
+The contact Jacobian is a saddle-point matrix on (u, lam)::
+
+    [ K   B^T ] [du  ]   [F_u  ]
+    [ C   D   ] [dlam] = [F_lam]
+
+with the elastic (plus contact) stiffness K, the gap gradient B, C = r B on
+active nodes and D the (lumped, diagonal) multiplier block on inactive ones.
+The iterative option is right-preconditioned GMRES with a Schur-complement
+field split: algebraic multigrid (GAMG) with the rigid body modes as its
+near-null space on the displacement block K, and the ``selfp`` Schur
+approximation D - C diag(K)^-1 B^T, factorised exactly (it lives on the
+contact surface only, so it is small). Systems with one block (penalty,
+Uzawa) get GMRES with GAMG directly.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from dolfinx import fem
+
+from petsc4py import PETSc
+
+LinearKind = Literal["direct", "iterative"]
+
+
+@dataclass(frozen=True)
+class LinearSolverSettings:
+    """How the Newton kernel solves J dx = F.
+
+    Attributes:
+        kind: 'direct' (LU, the default, MUMPS) or 'iterative' (GMRES with
+            a Schur field split and GAMG on the displacement block).
+        factor: LU package of the direct solver, and of the Schur block.
+        rtol: Krylov relative tolerance (unpreconditioned residual, right
+            preconditioning). Tight by default so that Newton counts match
+            the direct solver's.
+        atol: Krylov absolute tolerance (force units, the residual's).
+        max_it: Krylov iteration limit per linear solve.
+        restart: GMRES restart length.
+        schur_fact: PETSc Schur factorisation type ('full', 'upper', 'lower', 'diag').
+        amg_threshold: GAMG drop tolerance for the strength graph (-1: keep all).
+        amg_smooth_its: GAMG smoothing sweeps per level.
+        reuse_interpolation: keep the GAMG prolongators between Newton steps
+            (only the Galerkin products are recomputed).
+    """
+
+    kind: LinearKind = "direct"
+    factor: str = "mumps"
+    rtol: float = 1e-10
+    atol: float = 1e-13
+    max_it: int = 1000
+    restart: int = 150
+    schur_fact: str = "full"
+    amg_threshold: float = 0.02
+    amg_smooth_its: int = 2
+    reuse_interpolation: bool = True
+
+    def __post_init__(self) -> None:
+        if self.kind not in ("direct", "iterative"):
+            raise ValueError(
+                f"Linear solver kind {self.kind!r} is unknown; use 'direct' or 'iterative'."
+            )
+        if not (0 < self.rtol < 1 and self.atol >= 0):
+            raise ValueError(f"Krylov tolerances need 0 < rtol < 1, atol >= 0 (got {self}).")
+
+
+def rigid_body_modes(V: fem.FunctionSpace) -> PETSc.NullSpace:
+    """Orthonormal rigid body modes of a vector P-k space (3 in 2D, 6 in 3D).
+
+    Args:
+        V: vector Lagrange space of the displacement (length units).
+
+    Returns:
+        A PETSc near-null space in the layout of V's owned degrees of freedom.
+    """
+    gdim = V.mesh.geometry.dim
+    bs = V.dofmap.index_map_bs
+    if bs != gdim:
+        raise ValueError(f"Rigid body modes need a {gdim}-vector space, got block size {bs}.")
+    n_local = V.dofmap.index_map.size_local
+    x = V.tabulate_dof_coordinates()[:n_local]
+    n_modes = 3 if gdim == 2 else 6
+    arrays = [np.zeros((n_local, bs)) for _ in range(n_modes)]
+    for i in range(gdim):  # translations
+        arrays[i][:, i] = 1.0
+    if gdim == 2:
+        arrays[2][:, 0], arrays[2][:, 1] = -x[:, 1], x[:, 0]
+    else:
+        arrays[3][:, 0], arrays[3][:, 1] = -x[:, 1], x[:, 0]
+        arrays[4][:, 0], arrays[4][:, 2] = x[:, 2], -x[:, 0]
+        arrays[5][:, 2], arrays[5][:, 1] = x[:, 1], -x[:, 2]
+    vecs = []
+    for a in arrays:
+        v = PETSc.Vec().createMPI((n_local * bs, PETSc.DECIDE), comm=V.mesh.comm)
+        v.setArray(a.ravel())
+        vecs.append(v)
+    # Gram-Schmidt: PETSc wants an orthonormal basis.
+    basis: list[PETSc.Vec] = []
+    for v in vecs:
+        w = v.copy()
+        for b in basis:
+            w.axpy(-w.dot(b), b)
+        w.normalize()
+        basis.append(w)
+    return PETSc.NullSpace().create(vectors=basis, comm=V.mesh.comm)
+
+
+def block_index_sets(A: PETSc.Mat, spaces: list[fem.FunctionSpace]) -> list[PETSc.IS]:
+    """Global row indices of each block of a blocked (kind='mpi') matrix on this rank.
+
+    DOLFINx orders each rank's owned rows block after block, so block i
+    occupies a contiguous stretch of the rank's ownership range.
+    """
+    start = A.getOwnershipRange()[0]
+    sets = []
+    for V in spaces:
+        n = V.dofmap.index_map.size_local * V.dofmap.index_map_bs
+        sets.append(PETSc.IS().createStride(n, first=start, step=1, comm=A.getComm()))
+        start += n
+    return sets
+
+
+def _set_options(prefix: str, options: dict[str, object]) -> None:
+    """Put defaults into the options database; values already there are kept."""
+    db = PETSc.Options()
+    for key, value in options.items():
+        name = f"{prefix}{key}"
+        if not db.hasName(name):
+            db[name] = str(value).lower() if isinstance(value, bool) else value
+
+
+def _amg_options(settings: LinearSolverSettings) -> dict[str, object]:
+    return {
+        "ksp_type": "preonly",
+        "pc_type": "gamg",
+        "pc_gamg_type": "agg",
+        "pc_gamg_threshold": settings.amg_threshold,
+        "pc_gamg_reuse_interpolation": settings.reuse_interpolation,
+        "mg_levels_ksp_type": "chebyshev",
+        "mg_levels_pc_type": "jacobi",
+        "mg_levels_ksp_max_it": settings.amg_smooth_its,
+        "mg_levels_esteig_ksp_type": "cg",
+    }
+
+
+def configure_ksp(
+    ksp: PETSc.KSP,
+    A: PETSc.Mat,
+    spaces: list[fem.FunctionSpace],
+    settings: LinearSolverSettings,
+) -> tuple:
+    """Set up ``ksp`` (operator ``A``, options prefix already set) as ``settings`` asks.
+
+    Options already in the PETSc options database under the KSP's prefix
+    win over these defaults (``setFromOptions`` runs last).
+
+    Returns:
+        PETSc objects (index sets, near-null space) the caller must keep
+        alive as long as the solver.
+    """
+    prefix = ksp.getOptionsPrefix() or ""
+    pc = ksp.getPC()
+    if settings.kind == "direct":
+        ksp.setType("preonly")
+        pc.setType("lu")
+        pc.setFactorSolverType(settings.factor)
+        ksp.setFromOptions()
+        return ()
+    ksp.setType("gmres")
+    ksp.setPCSide(PETSc.PC.Side.RIGHT)
+    ksp.setTolerances(rtol=settings.rtol, atol=settings.atol, max_it=settings.max_it)
+    ksp.setGMRESRestart(settings.restart)
+    near_null = rigid_body_modes(spaces[0])
+    if len(spaces) == 1:
+        A.setNearNullSpace(near_null)
+        _set_options(prefix, {k: v for k, v in _amg_options(settings).items() if k != "ksp_type"})
+        pc.setType("gamg")
+        ksp.setFromOptions()
+        return (near_null,)
+    if len(spaces) != 2:
+        raise ValueError(f"The iterative solver handles 1 or 2 blocks, got {len(spaces)}.")
+    is_u, is_lam = block_index_sets(A, spaces)
+    # PCFIELDSPLIT hands a near-null space composed on a split's IS to its sub-matrix.
+    is_u.compose("nearnullspace", near_null)
+    pc.setType("fieldsplit")
+    pc.setFieldSplitIS(("u", is_u), ("lam", is_lam))
+    pc.setFieldSplitType(PETSc.PC.CompositeType.SCHUR)
+    options: dict[str, object] = {
+        "pc_fieldsplit_schur_fact_type": settings.schur_fact,
+        "pc_fieldsplit_schur_precondition": "selfp",
+        "fieldsplit_lam_ksp_type": "preonly",
+        "fieldsplit_lam_pc_type": "lu",
+        "fieldsplit_lam_pc_factor_mat_solver_type": settings.factor,
+    }
+    options.update({f"fieldsplit_u_{k}": v for k, v in _amg_options(settings).items()})
+    _set_options(prefix, options)
+    ksp.setFromOptions()
+    return (is_u, is_lam, near_null)

@@ -1,0 +1,66 @@
+"""3D Hertz validation: a sphere octant on a rigid plane (small strain and neo-Hookean).
+
+The mesh is graded to h = 0.015 R at the contact point (2796 displacement
+DOFs, 56 nodes in contact at push 0.01 R, a ~ 0.10 R). Measured errors of the
+fitted contact radius and peak pressure: +0.55 % and +1.7 % (linear); on the
+refined mesh of ``benchmarks/hertz3d.py`` (h = 0.007 R) -0.03 % and +0.5 %.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import fenics_contact  # noqa: F401  (before dolfinx)
+from fenics_contact.contact import ContactSettings
+from fenics_contact.diagnostics import SolverSettings
+from fenics_contact.hertz3d import force_for_radius, hertz_point_contact
+from fenics_contact.hertz_sphere import HertzSphere, measure_hertz_sphere
+from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.predictor import Extrapolated
+from fenics_contact.solvers.stepping import solve_load_path
+
+TOLERANCE = 0.02
+
+
+def test_point_contact_formulas() -> None:
+    P, R, E, nu = 0.8, 2.0, 200.0, 0.3
+    sol = hertz_point_contact(P, R, E, nu)
+    assert force_for_radius(sol.a, R, E, nu) == pytest.approx(P, rel=1e-13)
+    # the elliptical pressure integrates to P over the disk of radius a
+    r = np.linspace(0.0, sol.a, 200001)
+    p = sol.p0 * np.sqrt(np.clip(1 - (r / sol.a) ** 2, 0, None))
+    integrand = p * 2 * np.pi * r
+    integral = np.sum(0.5 * (integrand[1:] + integrand[:-1]) * np.diff(r))
+    assert integral == pytest.approx(P, rel=1e-5)
+    assert sol.delta == pytest.approx(sol.a**2 / R, rel=1e-14)
+    with pytest.raises(ValueError, match="must be > 0"):
+        hertz_point_contact(-1.0, R, E, nu)
+
+
+def solve(law: str, h: float) -> tuple:
+    sphere = HertzSphere(h_contact=h, law=law)
+    problem = sphere.build(ContactSettings(r=1.0))
+    strategy = Extrapolated(make_strategy("gnrm", problem, SolverSettings(atol=1e-10)))
+    path = solve_load_path(strategy, 2)
+    return sphere, problem, path
+
+
+@pytest.mark.mpi
+def test_linear_sphere_matches_hertz() -> None:
+    sphere, problem, path = solve("linear", 0.015)
+    assert path.converged
+    c = measure_hertz_sphere(problem, sphere)
+    assert c.fit.n_contact >= 40
+    assert 0.05 < c.hertz.a / sphere.radius < 0.15
+    assert abs(c.a_error) < TOLERANCE, (c.fit.a, c.hertz.a)
+    assert abs(c.p0_error) < TOLERANCE, (c.fit.p0, c.hertz.p0)
+    assert c.max_penetration < 1e-12
+
+
+def test_neo_hookean_sphere_at_small_load_stays_close_to_hertz() -> None:
+    sphere, problem, path = solve("neo-hookean", 0.02)
+    assert path.converged
+    c = measure_hertz_sphere(problem, sphere)
+    assert abs(c.a_error) < TOLERANCE, (c.fit.a, c.hertz.a)
+    assert abs(c.p0_error) < 2 * TOLERANCE, (c.fit.p0, c.hertz.p0)

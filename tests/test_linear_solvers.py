@@ -1,0 +1,91 @@
+"""The iterative linear solver (GMRES, Schur field split, GAMG) gives the MUMPS answer.
+
+Same Newton counts, displacement equal to a tight tolerance, on the 3D
+indentation ladder problem at a small size, for the saddle-point (GNRM) and
+the single-block (penalty) systems; and the kernel's time accounts add up.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mpi4py import MPI
+
+import fenics_contact  # noqa: F401  (before dolfinx)
+from fenics_contact.contact import ContactSettings
+from fenics_contact.diagnostics import SolverSettings
+from fenics_contact.indentation import BlockIndentation, cells_for_dofs
+from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.linear import LinearSolverSettings, rigid_body_modes
+from fenics_contact.solvers.predictor import Extrapolated
+from fenics_contact.solvers.stepping import solve_load_path
+
+NEWTON = SolverSettings(atol=1e-12, rtol=1e-10, max_iterations=30)
+
+
+def solve(kind: str, method: str = "gnrm", comm: MPI.Comm = MPI.COMM_WORLD, n: int = 6) -> tuple:
+    problem = BlockIndentation(n=n, depth=0.03, candidate_radius=0.5).build(
+        ContactSettings(r=1.0), comm
+    )
+    strategy = make_strategy(method, problem, NEWTON)
+    strategy.kernel.set_linear_solver(LinearSolverSettings(kind=kind))
+    path = solve_load_path(Extrapolated(strategy), 2, max_cutbacks=0)
+    return problem, path, strategy.kernel
+
+
+def test_cells_for_dofs() -> None:
+    assert cells_for_dofs(1e6) == 68
+    assert 3 * (cells_for_dofs(1e4) + 1) ** 3 == pytest.approx(1e4, rel=0.05)
+
+
+def test_rigid_body_modes_are_orthonormal() -> None:
+    problem = BlockIndentation(n=4, candidate_radius=0.6).build(ContactSettings())
+    basis = rigid_body_modes(problem.V).getVecs()
+    gram = np.array([[a.dot(b) for b in basis] for a in basis])
+    assert gram.shape == (6, 6)
+    assert np.allclose(gram, np.eye(6), atol=1e-12)
+
+
+@pytest.mark.parametrize("method", ["gnrm", "penalty"])
+def test_iterative_solver_reproduces_mumps(method: str) -> None:
+    direct, path_d, kernel_d = solve("direct", method)
+    iterative, path_i, kernel_i = solve("iterative", method)
+    assert path_d.converged and path_i.converged
+    assert [s.iterations for s in path_i.steps] == [s.iterations for s in path_d.steps]
+    assert [s.active_count for s in path_i.steps] == [s.active_count for s in path_d.steps]
+    ud, ui = direct.u.x.array, iterative.u.x.array
+    assert np.abs(ui - ud).max() <= 1e-9 * np.abs(ud).max()
+    assert path_i.steps[-1].contact_force == pytest.approx(path_d.steps[-1].contact_force,
+                                                          rel=1e-9)
+    assert kernel_i.timings.krylov_iterations > 0
+    assert kernel_d.timings.krylov_iterations == 0
+
+
+def test_kernel_accounts_add_up() -> None:
+    _, path, kernel = solve("direct")
+    t = kernel.timings
+    assert t.linear_solves == t.jacobians == path.linear_solves == path.iterations
+    assert t.residuals == path.iterations + len(path.steps)
+    assert min(t.compile_s, t.residual_s, t.jacobian_s, t.setup_s, t.solve_s) > 0
+    assert t.assembly_s == t.residual_s + t.jacobian_s
+
+
+@pytest.mark.mpi
+def test_parallel_iterative_run_matches_serial() -> None:
+    """On 2 ranks under `make test`: the same Newton counts and answer as on one."""
+    results = {}
+    for name, comm in (("world", MPI.COMM_WORLD), ("self", MPI.COMM_SELF)):
+        problem, path, _ = solve("iterative", comm=comm)
+        assert path.converged
+        results[name] = (
+            [s.iterations for s in path.steps],
+            [s.active_count for s in path.steps],
+            path.steps[-1].contact_force,
+            problem.u.x.petsc_vec.norm(),
+        )
+    world, serial = results["world"], results["self"]
+    assert world[0] == serial[0]
+    assert world[1] == serial[1]
+    assert world[2] == pytest.approx(serial[2], rel=1e-9)
+    assert world[3] == pytest.approx(serial[3], rel=1e-9)
