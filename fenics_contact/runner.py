@@ -16,6 +16,8 @@ from fenics_contact.scene import Scene
 from fenics_contact.scene_build import build_problem
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.base import SolveResult
+from fenics_contact.solvers.linear import LinearSolverSettings
+from fenics_contact.solvers.predictor import Extrapolated
 from fenics_contact.solvers.stepping import PathResult, StepRecord, solve_load_path
 
 
@@ -43,6 +45,8 @@ def _summary(scene: Scene, problem: ContactProblem, path: PathResult | None, wal
         "r_absolute": problem.r_absolute,
         "r_relative": problem.r_relative,
         "quadrature": scene.contact.quadrature,
+        "predictor": scene.solver.predictor,
+        "linear_solver": scene.solver.linear_solver,
         "displacement_dofs": problem.V.dofmap.index_map.size_global * problem.V.dofmap.index_map_bs,
         "multiplier_dofs": problem.surface.num_dofs,
         "load_steps": scene.solver.steps,
@@ -76,6 +80,12 @@ def run_scene(
     )
     strategy = make_strategy(scene.solver.method, problem, settings)
     strategy.observer = on_residual  # type: ignore[attr-defined]
+    if scene.solver.linear_solver == "iterative":
+        strategy.kernel.set_linear_solver(  # type: ignore[attr-defined]
+            LinearSolverSettings(kind="iterative")
+        )
+    if scene.solver.predictor == "extrapolate":
+        strategy = Extrapolated(strategy)
     writer = StepWriter(problem, out / "solution.xdmf", scene.fields)
     done: list[StepRecord] = []
 

@@ -19,7 +19,11 @@ Layout (units are the user's; be consistent)::
     [obstacle]   type = "plane" (point, normal) | "ball" (centre, radius,
                  inside), motion = [...] (displacement at load factor 1)
     [contact]    tag, or detect = true with margin; r, relative, quadrature
-    [solver]     method, steps, max_iterations, atol, rtol, max_cutbacks
+    [solver]     method, steps, max_iterations, atol, rtol, max_cutbacks,
+                 predictor = "extrapolate" (start a step from the linear
+                 extrapolation of the last two) | "previous",
+                 linear_solver = "direct" (MUMPS) | "iterative" (GMRES,
+                 Schur field split, algebraic multigrid; for large 3D)
     [output]     fields = [...], pictures = true
 
 Generated meshes tag their sides: rectangle left = 1, right = 2,
@@ -56,7 +60,8 @@ _SCHEMA: dict[str, set[str]] = {
     "traction": {"tag", "value"},
     "obstacle": {"type", "point", "normal", "centre", "radius", "inside", "motion"},
     "contact": {"tag", "detect", "margin", "r", "relative", "quadrature"},
-    "solver": {"method", "steps", "max_iterations", "atol", "rtol", "max_cutbacks"},
+    "solver": {"method", "steps", "max_iterations", "atol", "rtol", "max_cutbacks", "predictor",
+               "linear_solver"},
     "output": {"fields", "pictures"},
 }
 
@@ -121,6 +126,8 @@ class SolverSpec:
     atol: float = 1e-8
     rtol: float = 1e-10
     max_cutbacks: int = 4
+    predictor: str = "extrapolate"
+    linear_solver: str = "direct"
 
 
 @dataclass(frozen=True)
@@ -371,6 +378,8 @@ def _solver(reader: _Reader) -> SolverSpec:
         atol=reader.number("atol", 1e-8, positive=True),
         rtol=reader.number("rtol", 1e-10) if "rtol" in reader.table else 1e-10,
         max_cutbacks=reader.integer("max_cutbacks", 4, minimum=0),
+        predictor=reader.choice("predictor", ("extrapolate", "previous"), default="extrapolate"),
+        linear_solver=reader.choice("linear_solver", ("direct", "iterative"), default="direct"),
     )
 
 

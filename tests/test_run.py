@@ -94,7 +94,11 @@ def test_demo_scene_files_describe_the_demo_problems(tmp_path):
     from fenics_contact.solvers import make_strategy
     from fenics_contact.solvers.stepping import solve_load_path
 
-    outcome = run_scene(load_scene(SCENES / "paper_ex2.toml"), tmp_path, pictures=False)
+    text = (SCENES / "paper_ex2.toml").read_text().replace(
+        "[solver]", '[solver]\npredictor = "previous"'
+    )
+    (tmp_path / "ex2.toml").write_text(text)
+    outcome = run_scene(load_scene(tmp_path / "ex2.toml"), tmp_path, pictures=False)
     example = BarOnCradle()
     problem = example.build(ContactSettings(r=100.0, relative=False))
     path = solve_load_path(make_strategy("gnrm", problem, SolverSettings()), example.steps)
@@ -102,3 +106,24 @@ def test_demo_scene_files_describe_the_demo_problems(tmp_path):
     assert outcome.path.steps[-1].contact_force == pytest.approx(
         path.steps[-1].contact_force, rel=1e-10
     )
+
+
+def test_scene_solver_options_give_the_same_answer(tmp_path):
+    """Predictor and iterative linear solver change the cost, not the solution."""
+    base = (SCENES / "block_3d.toml").read_text()
+    forces, iterations = {}, {}
+    for name, extra in (
+        ("plain", 'predictor = "previous"'),
+        ("extrapolated", 'predictor = "extrapolate"'),
+        ("iterative", 'linear_solver = "iterative"'),
+    ):
+        (tmp_path / f"{name}.toml").write_text(base.replace("[solver]", f"[solver]\n{extra}"))
+        outcome = run_scene(
+            load_scene(tmp_path / f"{name}.toml"), tmp_path / name, pictures=False
+        )
+        assert outcome.path.converged
+        forces[name] = outcome.path.steps[-1].contact_force
+        iterations[name] = outcome.path.iterations
+    assert forces["extrapolated"] == pytest.approx(forces["plain"], rel=1e-8)
+    assert forces["iterative"] == pytest.approx(forces["plain"], rel=1e-8)
+    assert iterations["extrapolated"] <= iterations["plain"]
