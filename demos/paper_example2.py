@@ -23,9 +23,11 @@
 import argparse
 from pathlib import Path
 
-import fenics_contact  # noqa: F401  (loads the DOLFINx wheel first)
 import numpy as np
+
 from mpi4py import MPI
+
+import fenics_contact  # noqa: F401  (loads the DOLFINx wheel first)
 from fenics_contact.contact import ContactSettings
 from fenics_contact.diagnostics import SolverSettings
 from fenics_contact.examples import BarOnCradle

@@ -10,6 +10,7 @@ uniaxial: with linear elasticity the nodal pressure is uniform and equals
 import numpy as np
 import pytest
 from dolfinx import mesh
+
 from mpi4py import MPI
 
 from fenics_contact.contact import ContactSettings
@@ -36,8 +37,8 @@ def block(dim, law, method="gnrm", quadrature="nodal"):
 
     free = (None,) * dim
     prescribed = [
-        PrescribedDisplacement(side(top_axis, 1.0), free[:-1] + (-DELTA,)),
-        PrescribedDisplacement(side(0, 0.0), (0.0,) + free[1:]),
+        PrescribedDisplacement(side(top_axis, 1.0), (*free[:-1], -DELTA)),
+        PrescribedDisplacement(side(0, 0.0), (0.0, *free[1:])),
     ]
     if dim == 3:
         prescribed.append(PrescribedDisplacement(side(1, 0.0), (None, 0.0, None)))
