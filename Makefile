@@ -22,7 +22,7 @@ $(VENV)/.installed: pyproject.toml
 demo: venv
 	$(BIN)/python demos/paper_example2.py --out $(OUT)/paper-ex2
 
-test: test-serial test-mpi
+test: lint test-serial test-mpi
 
 test-serial: venv
 	$(BIN)/python -m pytest -q
@@ -36,7 +36,6 @@ meshes: venv
 	$(BIN)/fenics-contact mesh
 
 lint: venv
-	$(BIN)/python -m pip install --quiet ruff
 	$(BIN)/ruff check fenics_contact tests demos benchmarks
 
 clean:
