@@ -45,6 +45,19 @@ def _obstacle_mesh(problem: ContactProblem, bounds: np.ndarray):
     return pyvista.Sphere(radius=radius, center=centre, theta_resolution=60, phi_resolution=60)
 
 
+def _contact_window(grid, bounds: np.ndarray, gdim: int) -> np.ndarray | None:
+    """2D: bounds around the pressed nodes when they span under a fifth of the body."""
+    pressed = grid.points[grid.point_data["contact pressure"] > 0]
+    if gdim != 2 or pressed.shape[0] == 0:
+        return None
+    lo, hi = pressed.min(axis=0), pressed.max(axis=0)
+    size = float(np.max(bounds[1] - bounds[0]))
+    if float(np.max(hi - lo)) > 0.2 * size:
+        return None
+    margin = max(float(np.max(hi - lo)), 0.02 * size)
+    return np.array([lo - margin, hi + margin])
+
+
 def deformed_contact_picture(problem: ContactProblem, path: Path, title: str = "") -> None:
     """Render the deformed body coloured by contact pressure into a PNG.
 
@@ -71,24 +84,44 @@ def deformed_contact_picture(problem: ContactProblem, path: Path, title: str = "
     disp[:, :gdim] = problem.u.x.array.reshape(-1, gdim)
     grid.points += disp
     grid.point_data["contact pressure"] = pressure.x.array.copy()
-    plotter = pyvista.Plotter(off_screen=True, window_size=(1200, 800))
-    plotter.add_mesh(
-        grid, scalars="contact pressure", cmap="inferno_r", show_edges=gdim == 2,
-        edge_color="#777777", scalar_bar_args={"title": "contact pressure -lam"},
-    )
     bounds = np.array(grid.bounds).reshape(3, 2).T
-    plotter.add_mesh(
-        _obstacle_mesh(problem, bounds), color="#555555", line_width=3,
-        opacity=1.0 if gdim == 2 else 0.25,
+    zoom = _contact_window(grid, bounds, gdim)
+    pressed = grid.point_data["contact pressure"] > 0
+    nodes = pyvista.PolyData(grid.points[pressed])
+    nodes.point_data["contact pressure"] = grid.point_data["contact pressure"][pressed]
+    clim = (0.0, max(float(grid.point_data["contact pressure"].max()), 1e-300))
+    shape = (1, 2) if zoom is not None else (1, 1)
+    plotter = pyvista.Plotter(
+        off_screen=True, window_size=(1600 if zoom is not None else 1200, 800), shape=shape
     )
-    if gdim == 2:
-        plotter.view_xy()
-        plotter.camera.parallel_projection = True
-    else:  # from below and aside, where the contact is usually seen
-        plotter.view_vector((1.0, -1.3, -0.8), viewup=(0.0, 0.0, 1.0))
-    pad = 0.1 * float(np.max(bounds[1] - bounds[0]))
-    lo, hi = bounds[0] - pad, bounds[1] + pad
-    plotter.reset_camera(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]))
+    views = [(bounds, "whole body")] + ([(zoom, "contact zone")] if zoom is not None else [])
+    for column, (window, label) in enumerate(views):
+        plotter.subplot(0, column)
+        plotter.add_mesh(
+            grid.copy(), scalars="contact pressure", cmap="inferno_r", show_edges=gdim == 2,
+            edge_color="#777777", clim=clim, scalar_bar_args={"title": "contact pressure -lam"},
+        )
+        if nodes.n_points and gdim == 2:  # the pressed nodes, visible at any zoom
+            plotter.add_mesh(
+                nodes.copy(), scalars="contact pressure", cmap="inferno_r", clim=clim,
+                render_points_as_spheres=True, point_size=9 if column else 6,
+                show_scalar_bar=False,
+            )
+        plotter.add_mesh(
+            _obstacle_mesh(problem, bounds), color="#555555", line_width=3,
+            opacity=1.0 if gdim == 2 else 0.25,
+        )
+        if gdim == 2:
+            plotter.view_xy()
+            plotter.camera.parallel_projection = True
+        else:  # from below and aside, where the contact is usually seen
+            plotter.view_vector((1.0, -1.3, -0.8), viewup=(0.0, 0.0, 1.0))
+        pad = 0.1 * float(np.max(window[1] - window[0]))
+        lo, hi = window[0] - pad, window[1] + pad
+        plotter.reset_camera(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]))
+        if zoom is not None:
+            plotter.add_text(label, position="lower_left", font_size=10)
+    plotter.subplot(0, 0)
     if title:
         plotter.add_text(title, font_size=12)
     path.parent.mkdir(parents=True, exist_ok=True)

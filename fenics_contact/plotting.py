@@ -9,6 +9,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+from matplotlib.ticker import MaxNLocator
 
 from fenics_contact.solvers import PAPER_NAMES
 from fenics_contact.study import RunRecord
@@ -67,6 +68,7 @@ def step_residuals(steps: Sequence, path: Path, title: str = "") -> None:
         history = [v for solve in step.residuals for v in solve]
         ax.semilogy(range(len(history)), history, "o-", ms=3, lw=1, label=f"step {step.step}")
     ax.set_xlabel("Newton iteration")
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_ylabel("static residual (L2 norm)")
     ax.set_title(title)
     if len(steps) <= 12:
