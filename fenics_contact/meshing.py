@@ -7,6 +7,9 @@ The gmsh model is created on one MPI rank only and distributed by
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 from dolfinx.io.gmsh import MeshData, model_to_mesh
 
 from mpi4py import MPI
@@ -64,36 +67,16 @@ def hertz_half_disk(
         The dolfinx ``MeshData``: use its ``mesh``, ``cell_tags`` and
         ``facet_tags``.
     """
-    if not radius > 0:
-        raise ValueError(f"The disk radius must be > 0, got {radius}.")
-    if not 0 < h_contact <= h_far:
-        raise ValueError(
-            f"Element sizes need 0 < h_contact <= h_far, got h_contact={h_contact}, h_far={h_far}."
-        )
-    fine = 0.1 * radius if fine_radius is None else fine_radius
-    coarse = 0.5 * radius if coarse_radius is None else coarse_radius
-    if not 0 <= fine < coarse:
-        raise ValueError(
-            f"Grading radii need 0 <= fine_radius < coarse_radius, got {fine} and {coarse}."
-        )
+    fine, coarse = _grading(
+        "disk", radius, h_contact, h_far,
+        0.1 * radius if fine_radius is None else fine_radius,
+        0.5 * radius if coarse_radius is None else coarse_radius,
+    )
 
-    import gmsh
-
-    owns_session = False
-    if comm.rank == rank and not gmsh.isInitialized():
-        gmsh.initialize(interruptible=False)
-        owns_session = True
-    try:
-        if comm.rank == rank:
-            _build_half_disk(gmsh, radius, h_contact, h_far, fine, coarse, verbosity)
-        data = model_to_mesh(gmsh.model, comm, rank, gdim=2)
-    finally:
-        if comm.rank == rank:
-            if owns_session:
-                gmsh.finalize()
-            else:
-                gmsh.model.remove()
-    return data
+    return mesh_on_rank(
+        comm, rank, 2,
+        lambda gmsh: _build_half_disk(gmsh, radius, h_contact, h_far, fine, coarse, verbosity),
+    )
 
 
 def _build_half_disk(
@@ -125,20 +108,7 @@ def _build_half_disk(
     gmsh.model.addPhysicalGroup(1, [top], TOP_TAG, name="top")
     gmsh.model.addPhysicalGroup(1, [arc_left, arc_right], CONTACT_TAG, name="contact")
 
-    field = gmsh.model.mesh.field
-    distance = field.add("Distance")
-    field.setNumbers(distance, "PointsList", [bottom])
-    threshold = field.add("Threshold")
-    field.setNumber(threshold, "InField", distance)
-    field.setNumber(threshold, "SizeMin", h_contact)
-    field.setNumber(threshold, "SizeMax", h_far)
-    field.setNumber(threshold, "DistMin", fine)
-    field.setNumber(threshold, "DistMax", coarse)
-    field.setAsBackgroundMesh(threshold)
-    # The field alone sets the size: no point sizes, no curvature sizes.
-    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-    gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
-    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+    _graded_toward(gmsh, [bottom], h_contact, h_far, fine, coarse)
     gmsh.option.setNumber("Mesh.Algorithm", 6)  # Frontal-Delaunay
     gmsh.model.mesh.generate(2)
 
@@ -187,36 +157,16 @@ def hertz_sphere_octant(
     Returns:
         The dolfinx ``MeshData`` (``mesh``, ``cell_tags``, ``facet_tags``).
     """
-    if not radius > 0:
-        raise ValueError(f"The sphere radius must be > 0, got {radius}.")
-    if not 0 < h_contact <= h_far:
-        raise ValueError(
-            f"Element sizes need 0 < h_contact <= h_far, got h_contact={h_contact}, h_far={h_far}."
-        )
-    fine = 0.15 * radius if fine_radius is None else fine_radius
-    coarse = 0.6 * radius if coarse_radius is None else coarse_radius
-    if not 0 <= fine < coarse:
-        raise ValueError(
-            f"Grading radii need 0 <= fine_radius < coarse_radius, got {fine} and {coarse}."
-        )
+    fine, coarse = _grading(
+        "sphere", radius, h_contact, h_far,
+        0.15 * radius if fine_radius is None else fine_radius,
+        0.6 * radius if coarse_radius is None else coarse_radius,
+    )
 
-    import gmsh
-
-    owns_session = False
-    if comm.rank == rank and not gmsh.isInitialized():
-        gmsh.initialize(interruptible=False)
-        owns_session = True
-    try:
-        if comm.rank == rank:
-            _build_sphere_octant(gmsh, radius, h_contact, h_far, fine, coarse, verbosity)
-        data = model_to_mesh(gmsh.model, comm, rank, gdim=3)
-    finally:
-        if comm.rank == rank:
-            if owns_session:
-                gmsh.finalize()
-            else:
-                gmsh.model.remove()
-    return data
+    return mesh_on_rank(
+        comm, rank, 3,
+        lambda gmsh: _build_sphere_octant(gmsh, radius, h_contact, h_far, fine, coarse, verbosity),
+    )
 
 
 def _build_sphere_octant(
@@ -258,9 +208,37 @@ def _build_sphere_octant(
 
     lowest = [tag for dim, tag in gmsh.model.getEntities(0)
               if max(abs(c) for c in gmsh.model.getValue(0, tag, [])) < tol]
+    _graded_toward(gmsh, lowest, h_contact, h_far, fine, coarse)
+    gmsh.model.mesh.generate(3)
+
+
+def _grading(
+    shape: str, radius: float, h_contact: float, h_far: float, fine: float, coarse: float
+) -> tuple[float, float]:
+    """Check the sizes of a graded mesh; return (fine, coarse) radii."""
+    if not radius > 0:
+        raise ValueError(f"The {shape} radius must be > 0, got {radius}.")
+    if not 0 < h_contact <= h_far:
+        raise ValueError(
+            f"Element sizes need 0 < h_contact <= h_far, got h_contact={h_contact}, h_far={h_far}."
+        )
+    if not 0 <= fine < coarse:
+        raise ValueError(
+            f"Grading radii need 0 <= fine_radius < coarse_radius, got {fine} and {coarse}."
+        )
+    return fine, coarse
+
+
+def _graded_toward(
+    gmsh: Any, points: list[int], h_contact: float, h_far: float, fine: float, coarse: float
+) -> None:
+    """Size field: h_contact within ``fine`` of the points, h_far beyond ``coarse``.
+
+    The field alone sets the size: no point sizes, no curvature sizes.
+    """
     field = gmsh.model.mesh.field
     distance = field.add("Distance")
-    field.setNumbers(distance, "PointsList", lowest)
+    field.setNumbers(distance, "PointsList", points)
     threshold = field.add("Threshold")
     field.setNumber(threshold, "InField", distance)
     field.setNumber(threshold, "SizeMin", h_contact)
@@ -271,4 +249,30 @@ def _build_sphere_octant(
     gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
     gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
     gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
-    gmsh.model.mesh.generate(3)
+
+
+def mesh_on_rank(
+    comm: MPI.Comm, rank: int, gdim: int, build: Callable[[Any], None]
+) -> MeshData:
+    """Run ``build(gmsh)`` on ``rank`` and distribute the resulting mesh over ``comm``.
+
+    Uses the caller's gmsh session when one is open (its model is removed
+    afterwards), or opens and closes its own. ``build`` must add and mesh a
+    model with physical groups.
+    """
+    import gmsh
+
+    owns_session = False
+    if comm.rank == rank and not gmsh.isInitialized():
+        gmsh.initialize(interruptible=False)
+        owns_session = True
+    try:
+        if comm.rank == rank:
+            build(gmsh)
+        return model_to_mesh(gmsh.model, comm, rank, gdim=gdim)
+    finally:
+        if comm.rank == rank:
+            if owns_session:
+                gmsh.finalize()
+            else:
+                gmsh.model.remove()

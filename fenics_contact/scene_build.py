@@ -9,6 +9,7 @@ before any form is compiled.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from dolfinx import mesh
@@ -17,6 +18,7 @@ from mpi4py import MPI
 
 from fenics_contact.contact import ContactSettings
 from fenics_contact.materials import material
+from fenics_contact.meshing import mesh_on_rank
 from fenics_contact.obstacles import RigidBall, RigidObstacle, RigidPlane
 from fenics_contact.problem import ContactProblem, PrescribedDisplacement, SurfaceTraction
 from fenics_contact.scene import GENERATOR_TAGS, BoundarySpec, Scene, SceneError
@@ -60,35 +62,48 @@ def _generated(scene: Scene, comm: MPI.Comm) -> BodyMesh:
     return BodyMesh(domain, tags, dict(names))
 
 
-def _from_gmsh(scene: Scene, comm: MPI.Comm) -> BodyMesh:
-    import gmsh
-    from dolfinx.io import gmsh as gmshio
+def _open(gmsh: Any, scene: Scene) -> None:
+    """Load the scene's .geo (parameters set) or .msh into the current gmsh session."""
+    gmsh.option.setNumber("General.Terminal", 0)
+    for name, value in scene.mesh.parameters.items():
+        gmsh.parser.setNumber(name, [float(value)])
+    gmsh.open(str(scene.mesh.file))
 
+
+def _physical_dimensions(scene: Scene, comm: MPI.Comm) -> set[int]:
+    """Dimensions of the file's physical groups (read on rank 0, known to all)."""
+    import gmsh
+
+    dims: set[int] = set()
+    if comm.rank == 0:
+        started = not gmsh.isInitialized()
+        if started:
+            gmsh.initialize(interruptible=False)
+        try:
+            _open(gmsh, scene)
+            dims = {d for d, _ in gmsh.model.getPhysicalGroups()}
+        finally:
+            gmsh.finalize() if started else gmsh.model.remove()
+    return comm.bcast(dims, root=0)
+
+
+def _from_gmsh(scene: Scene, comm: MPI.Comm) -> BodyMesh:
     spec = scene.mesh
     assert spec.file is not None
-    started = not gmsh.isInitialized()
-    if started:
-        gmsh.initialize()
-    gmsh.option.setNumber("General.Terminal", 0)
-    try:
-        if comm.rank == 0:
-            gmsh.clear()
-            for name, value in spec.parameters.items():
-                gmsh.parser.setNumber(name, [float(value)])
-            gmsh.open(str(spec.file))
-            if spec.file.suffix == ".geo":
-                gmsh.model.mesh.generate(scene.dimension)
-            dims = {d for d, _ in gmsh.model.getPhysicalGroups()}
-            if scene.dimension not in dims:
-                raise SceneError(
-                    f"{scene.path.name}: [scene] dimension = {scene.dimension}, but the mesh "
-                    f"{spec.file.name} has no {scene.dimension}D physical group; set the "
-                    "dimension to the mesh's or add a physical group for the body."
-                )
-        data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=scene.dimension)
-    finally:
-        if started:
-            gmsh.finalize()
+    dims = _physical_dimensions(scene, comm)
+    if scene.dimension not in dims:
+        raise SceneError(
+            f"{scene.path.name}: [scene] dimension = {scene.dimension}, but the mesh "
+            f"{spec.file.name} has no {scene.dimension}D physical group; set the "
+            "dimension to the mesh's or add a physical group for the body."
+        )
+
+    def build(gmsh: Any) -> None:
+        _open(gmsh, scene)
+        if spec.file is not None and spec.file.suffix == ".geo":
+            gmsh.model.mesh.generate(scene.dimension)
+
+    data = mesh_on_rank(comm, 0, scene.dimension, build)
     if data.facet_tags is None:
         raise SceneError(f"{spec.file}: the mesh has no physical groups on its boundary.")
     fdim = scene.dimension - 1
