@@ -22,6 +22,7 @@ from fenics_contact.hertz import (
     hertz_line_contact,
     relative_error,
 )
+from fenics_contact.hertz3d import HertzPointContact
 from fenics_contact.materials import LinearElastic
 from fenics_contact.meshing import CONTACT_TAG, TOP_TAG, hertz_half_disk
 from fenics_contact.obstacles import RigidPlane
@@ -130,9 +131,11 @@ def contact_profile(problem: ContactProblem) -> tuple[np.ndarray, np.ndarray]:
 class HertzComparison:
     """The finite element contact state against Hertz theory at the same load.
 
+    Serves line contact (2D) and point contact (3D).
+
     Attributes:
-        P: total contact force per unit thickness (force / length), measured.
-        hertz: the analytic solution for that P.
+        P: total contact force, measured (per unit thickness in 2D).
+        hertz: the analytic solution for that P (line or point contact).
         fit: half-width and peak from the nodal pressures.
         a_error: relative error of the fitted half-width.
         p0_error: relative error of the fitted peak pressure.
@@ -141,7 +144,7 @@ class HertzComparison:
     """
 
     P: float
-    hertz: HertzSolution
+    hertz: HertzSolution | HertzPointContact
     fit: ContactProfileFit
     a_error: float
     p0_error: float
@@ -151,6 +154,25 @@ class HertzComparison:
     def to_dict(self) -> dict:
         """Plain-data view for JSON."""
         return asdict(self)
+
+    @classmethod
+    def of(
+        cls,
+        force: float,
+        hertz: HertzSolution | HertzPointContact,
+        fit: ContactProfileFit,
+        max_penetration: float,
+    ) -> HertzComparison:
+        """Relative errors of the fitted and nodal values against ``hertz``."""
+        return cls(
+            P=force,
+            hertz=hertz,
+            fit=fit,
+            a_error=relative_error(fit.a, hertz.a),
+            p0_error=relative_error(fit.p0, hertz.p0),
+            nodal_peak_error=relative_error(fit.nodal_peak, hertz.p0),
+            max_penetration=max_penetration,
+        )
 
 
 def measure_hertz(problem: ContactProblem, cylinder: HertzCylinder) -> HertzComparison:
@@ -173,12 +195,4 @@ def measure_hertz(problem: ContactProblem, cylinder: HertzCylinder) -> HertzComp
         )
     fit = fit_contact_profile(x, p)
     hertz = hertz_line_contact(state.contact_force, cylinder.radius, cylinder.E, cylinder.nu)
-    return HertzComparison(
-        P=state.contact_force,
-        hertz=hertz,
-        fit=fit,
-        a_error=relative_error(fit.a, hertz.a),
-        p0_error=relative_error(fit.p0, hertz.p0),
-        nodal_peak_error=relative_error(fit.nodal_peak, hertz.p0),
-        max_penetration=state.max_penetration,
-    )
+    return HertzComparison.of(state.contact_force, hertz, fit, state.max_penetration)

@@ -9,7 +9,7 @@ octant's, the model being a quarter of the lower hemisphere).
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 from dolfinx import mesh
@@ -17,8 +17,9 @@ from dolfinx import mesh
 from mpi4py import MPI
 
 from fenics_contact.contact import ContactSettings
-from fenics_contact.hertz import ContactProfileFit, fit_contact_profile, relative_error
-from fenics_contact.hertz3d import HertzPointContact, hertz_point_contact
+from fenics_contact.hertz import fit_contact_profile
+from fenics_contact.hertz3d import hertz_point_contact
+from fenics_contact.hertz_problem import HertzComparison
 from fenics_contact.materials import Elastic, LinearElastic, NeoHookean
 from fenics_contact.meshing import (
     CONTACT_TAG,
@@ -93,31 +94,8 @@ class HertzSphere:
         )
 
 
-@dataclass(frozen=True)
-class SphereComparison:
-    """The finite element contact state against 3D Hertz theory at the same force.
-
-    Attributes:
-        P: total contact force of the whole sphere (force), measured.
-        hertz: the analytic solution for that force.
-        fit: contact radius and peak from the nodal pressures (radial coordinate).
-        a_error: relative error of the fitted contact radius.
-        p0_error: relative error of the fitted peak pressure.
-        nodal_peak_error: relative error of the largest nodal pressure.
-        max_penetration: largest nodal penetration (length).
-    """
-
-    P: float
-    hertz: HertzPointContact
-    fit: ContactProfileFit
-    a_error: float
-    p0_error: float
-    nodal_peak_error: float
-    max_penetration: float
-
-    def to_dict(self) -> dict:
-        """Plain-data view for JSON."""
-        return asdict(self)
+#: The 3D comparison has the fields of the 2D one (contact radius for half-width).
+SphereComparison = HertzComparison
 
 
 def measure_hertz_sphere(problem: ContactProblem, sphere: HertzSphere) -> SphereComparison:
@@ -133,12 +111,4 @@ def measure_hertz_sphere(problem: ContactProblem, sphere: HertzSphere) -> Sphere
     fit = fit_contact_profile(r, p)
     force = COPIES * state.contact_force
     hertz = hertz_point_contact(force, sphere.radius, sphere.E, sphere.nu)
-    return SphereComparison(
-        P=force,
-        hertz=hertz,
-        fit=fit,
-        a_error=relative_error(fit.a, hertz.a),
-        p0_error=relative_error(fit.p0, hertz.p0),
-        nodal_peak_error=relative_error(fit.nodal_peak, hertz.p0),
-        max_penetration=state.max_penetration,
-    )
+    return HertzComparison.of(force, hertz, fit, state.max_penetration)
