@@ -17,16 +17,22 @@ from typing import Literal
 
 import numpy as np
 import ufl
-from dolfinx import fem, mesh
+from dolfinx import fem, la, mesh
 
 from mpi4py import MPI
-
-from fenics_contact.petsc_vectors import assemble_local
 
 Quadrature = Literal["nodal", "gauss"]
 
 #: Tag given to candidate contact facets in the facet tags of ``ds``.
 CONTACT_TAG = 1
+
+
+def assemble_local(compiled: fem.Form) -> np.ndarray:
+    """Assemble a linear form; return the owned entries with ghost contributions summed in."""
+    vec = fem.assemble_vector(compiled)
+    vec.scatter_reverse(la.InsertMode.add)
+    n = vec.index_map.size_local * vec.block_size
+    return vec.array[:n].copy()
 
 
 def penalty_energy(g: ufl.core.expr.Expr, r: ufl.core.expr.Expr) -> ufl.core.expr.Expr:

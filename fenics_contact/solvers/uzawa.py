@@ -15,8 +15,8 @@ from dolfinx import fem
 
 from mpi4py import MPI
 
+from fenics_contact.contact import assemble_local
 from fenics_contact.diagnostics import SolverSettings
-from fenics_contact.petsc_vectors import assemble_local
 from fenics_contact.problem import ContactProblem
 from fenics_contact.solvers.newton import NewtonKernel
 
