@@ -20,7 +20,7 @@ from fenics_contact.contact import ContactSettings
 from fenics_contact.hertz import fit_contact_profile
 from fenics_contact.hertz3d import hertz_point_contact
 from fenics_contact.hertz_problem import HertzComparison
-from fenics_contact.materials import Elastic, LinearElastic, NeoHookean
+from fenics_contact.materials import Elastic, material
 from fenics_contact.meshing import (
     CONTACT_TAG,
     SYMMETRY_X_TAG,
@@ -69,8 +69,7 @@ class HertzSphere:
 
     def material(self) -> Elastic:
         """The body's law."""
-        laws = {"linear": LinearElastic, "neo-hookean": NeoHookean}
-        return laws[self.law](E=self.E, nu=self.nu)
+        return material(self.law, self.E, self.nu)
 
     def build(self, settings: ContactSettings, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProblem:
         """Mesh the octant and create the contact problem (load factor 1 = ``push``)."""

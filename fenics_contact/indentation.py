@@ -19,7 +19,7 @@ from dolfinx import mesh
 from mpi4py import MPI
 
 from fenics_contact.contact import ContactSettings
-from fenics_contact.materials import Elastic, LinearElastic, NeoHookean
+from fenics_contact.materials import Elastic, material
 from fenics_contact.obstacles import RigidBall
 from fenics_contact.problem import ContactProblem, PrescribedDisplacement
 
@@ -57,8 +57,7 @@ class BlockIndentation:
 
     def material(self) -> Elastic:
         """The block's law."""
-        laws = {"linear": LinearElastic, "neo-hookean": NeoHookean}
-        return laws[self.law](E=self.E, nu=self.nu)
+        return material(self.law, self.E, self.nu)
 
     def build(self, settings: ContactSettings, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProblem:
         """Create the mesh and the contact problem (load factor 1 = ``depth``)."""
