@@ -18,12 +18,12 @@ from pathlib import Path
 from mpi4py import MPI
 
 import fenics_contact  # noqa: F401
-from fenics_contact.bench_scenes import BarScene, HertzScene
-from fenics_contact.contact import ContactSettings
-from fenics_contact.diagnostics import SolverSettings
-from fenics_contact.io import write_json
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.output.io import write_json
 from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.stepping import solve_load_path
+from fenics_contact.verification.bench_scenes import BarScene, HertzScene
 
 SCENES = {
     "hertz h=0.004": (HertzScene(h_contact=0.004), 200.0 / 0.004, 1e-10),

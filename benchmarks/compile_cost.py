@@ -25,8 +25,8 @@ import json, time, sys
 sys.path.insert(0, {here!r})
 start = time.perf_counter()
 import fenics_contact
-from fenics_contact.contact import ContactSettings
-from fenics_contact.diagnostics import SolverSettings
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers import make_strategy
 from hertz2d import CYLINDER
 import_s = time.perf_counter() - start

@@ -25,11 +25,11 @@ from dolfinx import fem
 from hertz2d import CYLINDER, STEPS
 
 import fenics_contact  # noqa: F401  (before dolfinx)
-from fenics_contact.contact import ContactSettings
-from fenics_contact.diagnostics import ConvergenceMonitor, SolverSettings
-from fenics_contact.problem import ContactProblem, VariationalSystem
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.model.problem import ContactProblem, VariationalSystem
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.base import newton_loop
+from fenics_contact.solvers.diagnostics import ConvergenceMonitor, SolverSettings
 from fenics_contact.solvers.newton import NewtonKernel
 from fenics_contact.solvers.predictor import Extrapolated
 from fenics_contact.solvers.stepping import solve_load_path

@@ -18,13 +18,13 @@ from pathlib import Path
 import harness
 
 import fenics_contact  # noqa: F401  (before dolfinx)
-from fenics_contact.contact import ContactSettings
-from fenics_contact.diagnostics import SolverSettings
-from fenics_contact.hertz import load_for_half_width, relative_error
-from fenics_contact.hertz_problem import HertzCylinder, measure_hertz
+from fenics_contact.model.contact import ContactSettings
 from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.predictor import Extrapolated
 from fenics_contact.solvers.stepping import solve_load_path
+from fenics_contact.verification.hertz import load_for_half_width, relative_error
+from fenics_contact.verification.hertz_problem import HertzCylinder, measure_hertz
 
 #: The issue-6 case: h = 0.008 at contact, fine zone 0.22 R -> 3814 displacement DOFs.
 CYLINDER = HertzCylinder(push=0.02, h_contact=0.008, fine_radius=0.22)

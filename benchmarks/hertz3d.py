@@ -17,12 +17,12 @@ from pathlib import Path
 import harness
 
 import fenics_contact  # noqa: F401  (before dolfinx)
-from fenics_contact.contact import ContactSettings
-from fenics_contact.diagnostics import SolverSettings
-from fenics_contact.hertz_sphere import HertzSphere, measure_hertz_sphere
+from fenics_contact.model.contact import ContactSettings
 from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.predictor import Extrapolated
 from fenics_contact.solvers.stepping import solve_load_path
+from fenics_contact.verification.hertz_sphere import HertzSphere, measure_hertz_sphere
 
 MESHES = (0.02, 0.01, 0.007)
 LAWS = ("linear", "neo-hookean")

@@ -49,11 +49,11 @@ import numpy as np
 from mpi4py import MPI
 
 import fenics_contact  # noqa: F401  (loads the DOLFINx wheel's libraries first)
-from fenics_contact.contact import ContactSettings
-from fenics_contact.diagnostics import SolverSettings, signorini_report
-from fenics_contact.hertz_problem import HertzCylinder, contact_profile, measure_hertz
+from fenics_contact.model.contact import ContactSettings
 from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings, signorini_report
 from fenics_contact.solvers.stepping import StepRecord, solve_load_path
+from fenics_contact.verification.hertz_problem import HertzCylinder, contact_profile, measure_hertz
 
 parser = argparse.ArgumentParser(description="Hertz line contact validation")
 parser.add_argument(

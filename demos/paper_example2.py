@@ -28,13 +28,13 @@ import numpy as np
 from mpi4py import MPI
 
 import fenics_contact  # noqa: F401  (loads the DOLFINx wheel first)
-from fenics_contact.contact import ContactSettings
-from fenics_contact.diagnostics import SolverSettings
-from fenics_contact.examples import BarOnCradle
-from fenics_contact.io import StepWriter, write_json
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.output.io import StepWriter, write_json
 from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.stepping import solve_load_path
-from fenics_contact.study import paper_table, reference_solution, run_one
+from fenics_contact.studies.study import paper_table, reference_solution, run_one
+from fenics_contact.verification.examples import BarOnCradle
 
 parser = argparse.ArgumentParser(description=__doc__)
 parser.add_argument("--out", type=Path, default=Path("results/paper-ex2"))

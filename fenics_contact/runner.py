@@ -9,13 +9,13 @@ from pathlib import Path
 
 from mpi4py import MPI
 
-from fenics_contact.diagnostics import SolverSettings
-from fenics_contact.io import StepWriter, write_json
-from fenics_contact.problem import ContactProblem
-from fenics_contact.scene import Scene
-from fenics_contact.scene_build import build_problem
+from fenics_contact.model.problem import ContactProblem
+from fenics_contact.output.io import StepWriter, write_json
+from fenics_contact.scene.build import build_problem
+from fenics_contact.scene.schema import Scene
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.base import SolveResult
+from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.predictor import Extrapolated
 from fenics_contact.solvers.stepping import PathResult, StepRecord, solve_load_path
@@ -110,8 +110,8 @@ def run_scene(
         write_json(out / "summary.json", summary)
     draw = scene.pictures if pictures is None else pictures
     if draw:
-        from fenics_contact.pictures import deformed_contact_picture
-        from fenics_contact.plotting import step_residuals
+        from fenics_contact.output.pictures import deformed_contact_picture
+        from fenics_contact.output.plotting import step_residuals
 
         deformed_contact_picture(
             problem, out / "deformed.png",

@@ -5,13 +5,13 @@ import pytest
 
 from mpi4py import MPI
 
-from fenics_contact.bench_scenes import BarScene, HertzScene
-from fenics_contact.contact import ContactSettings
-from fenics_contact.diagnostics import SolverSettings, Status
-from fenics_contact.scaling import force_scale, residual_floor, scaled_atol
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.model.scaling import force_scale, residual_floor, scaled_atol
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.auto import AutoStrategy
+from fenics_contact.solvers.diagnostics import SolverSettings, Status
 from fenics_contact.solvers.stepping import solve_load_path
+from fenics_contact.verification.bench_scenes import BarScene, HertzScene
 
 BAR = BarScene()
 

@@ -6,14 +6,14 @@ from dolfinx import mesh
 
 from mpi4py import MPI
 
-from fenics_contact.bench_scenes import BarScene, HertzScene
-from fenics_contact.candidates import boundary_facets, detect_candidate_facets
-from fenics_contact.contact import ContactSettings
-from fenics_contact.diagnostics import SolverSettings
-from fenics_contact.obstacles import RigidBall
-from fenics_contact.scaling import scaled_atol
+from fenics_contact.model.candidates import boundary_facets, detect_candidate_facets
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.model.obstacles import RigidBall
+from fenics_contact.model.scaling import scaled_atol
 from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.stepping import solve_load_path
+from fenics_contact.verification.bench_scenes import BarScene, HertzScene
 
 
 def solved(scene):

@@ -2,7 +2,7 @@
 
 import math
 
-from fenics_contact.diagnostics import ConvergenceMonitor, SolverSettings, Status
+from fenics_contact.solvers.diagnostics import ConvergenceMonitor, SolverSettings, Status
 
 
 def feed(monitor, values, states=None):

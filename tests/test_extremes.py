@@ -5,14 +5,14 @@ import math
 
 import pytest
 
-from fenics_contact.bench_scenes import BarScene
-from fenics_contact.stability import (
+from fenics_contact.studies.stability import (
     ERROR,
     StabilityCase,
     full_grid,
     run_case,
     select,
 )
+from fenics_contact.verification.bench_scenes import BarScene
 
 CASES = {c.name: c for c in full_grid()}
 

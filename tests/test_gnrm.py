@@ -8,11 +8,11 @@ import pytest
 
 from mpi4py import MPI
 
-from fenics_contact.contact import ContactSettings
-from fenics_contact.diagnostics import SolverSettings, signorini_report
-from fenics_contact.examples import PAPER_E, BarOnCradle
+from fenics_contact.model.contact import ContactSettings
 from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings, signorini_report
 from fenics_contact.solvers.stepping import solve_load_path
+from fenics_contact.verification.examples import PAPER_E, BarOnCradle
 
 EXAMPLE = BarOnCradle()
 

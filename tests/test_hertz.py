@@ -22,9 +22,12 @@ import pytest
 from mpi4py import MPI
 
 import fenics_contact  # noqa: F401  (before dolfinx)
-from fenics_contact.contact import ContactSettings
-from fenics_contact.diagnostics import SolverSettings
-from fenics_contact.hertz import (
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.scene.meshing import CONTACT_TAG, TOP_TAG, hertz_half_disk
+from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings
+from fenics_contact.solvers.stepping import solve_load_path
+from fenics_contact.verification.hertz import (
     fit_contact_profile,
     half_width,
     hertz_line_contact,
@@ -33,10 +36,7 @@ from fenics_contact.hertz import (
     plane_strain_modulus,
     pressure_profile,
 )
-from fenics_contact.hertz_problem import HertzCylinder, measure_hertz
-from fenics_contact.meshing import CONTACT_TAG, TOP_TAG, hertz_half_disk
-from fenics_contact.solvers import make_strategy
-from fenics_contact.solvers.stepping import solve_load_path
+from fenics_contact.verification.hertz_problem import HertzCylinder, measure_hertz
 
 TOLERANCE = 0.02
 

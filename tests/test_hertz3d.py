@@ -12,13 +12,13 @@ import numpy as np
 import pytest
 
 import fenics_contact  # noqa: F401  (before dolfinx)
-from fenics_contact.contact import ContactSettings
-from fenics_contact.diagnostics import SolverSettings
-from fenics_contact.hertz3d import force_for_radius, hertz_point_contact
-from fenics_contact.hertz_sphere import HertzSphere, measure_hertz_sphere
+from fenics_contact.model.contact import ContactSettings
 from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.predictor import Extrapolated
 from fenics_contact.solvers.stepping import solve_load_path
+from fenics_contact.verification.hertz3d import force_for_radius, hertz_point_contact
+from fenics_contact.verification.hertz_sphere import HertzSphere, measure_hertz_sphere
 
 TOLERANCE = 0.02
 

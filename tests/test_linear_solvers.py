@@ -13,13 +13,13 @@ import pytest
 from mpi4py import MPI
 
 import fenics_contact  # noqa: F401  (before dolfinx)
-from fenics_contact.contact import ContactSettings
-from fenics_contact.diagnostics import SolverSettings
-from fenics_contact.indentation import BlockIndentation, cells_for_dofs
+from fenics_contact.model.contact import ContactSettings
 from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.linear import LinearSolverSettings, rigid_body_modes
 from fenics_contact.solvers.predictor import Extrapolated
 from fenics_contact.solvers.stepping import solve_load_path
+from fenics_contact.verification.indentation import BlockIndentation, cells_for_dofs
 
 NEWTON = SolverSettings(atol=1e-12, rtol=1e-10, max_iterations=30)
 

@@ -13,12 +13,12 @@ from dolfinx import mesh
 
 from mpi4py import MPI
 
-from fenics_contact.contact import ContactSettings
-from fenics_contact.diagnostics import SolverSettings
-from fenics_contact.materials import LinearElastic, NeoHookean
-from fenics_contact.obstacles import RigidPlane
-from fenics_contact.problem import ContactProblem, PrescribedDisplacement
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.model.materials import LinearElastic, NeoHookean
+from fenics_contact.model.obstacles import RigidPlane
+from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
 from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.stepping import solve_load_path
 
 E, NU, DELTA = 100.0, 0.3, 1e-3

@@ -7,14 +7,14 @@ from dolfinx import fem, mesh
 
 from mpi4py import MPI
 
-from fenics_contact.contact import (
+from fenics_contact.model.contact import (
     ContactSettings,
     ContactSurface,
     augmented_lagrangian_energy,
     penalty_energy,
 )
-from fenics_contact.materials import LinearElastic, NeoHookean, SaintVenantKirchhoff, material
-from fenics_contact.obstacles import RigidBall, RigidPlane
+from fenics_contact.model.materials import LinearElastic, NeoHookean, SaintVenantKirchhoff, material
+from fenics_contact.model.obstacles import RigidBall, RigidPlane
 
 E, NU = 210.0, 0.3
 

@@ -13,13 +13,13 @@ import numpy as np
 import pytest
 
 import fenics_contact  # noqa: F401  (before dolfinx)
-from fenics_contact.contact import ContactSettings
-from fenics_contact.diagnostics import SolverSettings
-from fenics_contact.examples import BarOnCradle
-from fenics_contact.hertz_problem import HertzCylinder
+from fenics_contact.model.contact import ContactSettings
 from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.predictor import Extrapolated
 from fenics_contact.solvers.stepping import solve_load_path
+from fenics_contact.verification.examples import BarOnCradle
+from fenics_contact.verification.hertz_problem import HertzCylinder
 
 CYLINDER = HertzCylinder(push=0.02, h_contact=0.008, fine_radius=0.22)
 

@@ -10,7 +10,7 @@ from mpi4py import MPI
 
 from fenics_contact.cli import main
 from fenics_contact.runner import run_scene
-from fenics_contact.scene import load_scene
+from fenics_contact.scene.schema import load_scene
 
 SCENES = Path(__file__).parent.parent / "scenes"
 FIELDS = {"displacement", "contact_pressure", "gap", "active"}
@@ -88,11 +88,11 @@ def test_failing_run_exits_nonzero_and_keeps_finished_steps(tmp_path, capsys):
 
 def test_demo_scene_files_describe_the_demo_problems(tmp_path):
     """scenes/paper_ex2.toml and the BarOnCradle builder of the demo give one answer."""
-    from fenics_contact.contact import ContactSettings
-    from fenics_contact.diagnostics import SolverSettings
-    from fenics_contact.examples import BarOnCradle
+    from fenics_contact.model.contact import ContactSettings
     from fenics_contact.solvers import make_strategy
+    from fenics_contact.solvers.diagnostics import SolverSettings
     from fenics_contact.solvers.stepping import solve_load_path
+    from fenics_contact.verification.examples import BarOnCradle
 
     text = (SCENES / "paper_ex2.toml").read_text().replace(
         "[solver]", '[solver]\npredictor = "previous"'

@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 from fenics_contact.cli import main
-from fenics_contact.scene import SceneError, load_scene
+from fenics_contact.scene.schema import SceneError, load_scene
 
 SCENES = Path(__file__).parent.parent / "scenes"
 EX2 = (SCENES / "paper_ex2.toml").read_text()
@@ -82,7 +82,7 @@ def test_missing_tag_fails_before_any_form_is_compiled(tmp_path, capsys):
 
 
 def test_wrong_dimension_of_a_gmsh_mesh_is_reported(tmp_path):
-    from fenics_contact.scene_build import build_problem
+    from fenics_contact.scene.build import build_problem
 
     text = (SCENES / "hertz_cylinder.toml").read_text()
     text = text.replace("dimension = 2", "dimension = 3").replace(

@@ -6,12 +6,12 @@ import numpy as np
 
 from mpi4py import MPI
 
-from fenics_contact.contact import ContactSettings
-from fenics_contact.diagnostics import SolverSettings, Status
-from fenics_contact.examples import BarOnCradle
-from fenics_contact.io import StepWriter, write_json
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.output.io import StepWriter, write_json
 from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings, Status
 from fenics_contact.solvers.stepping import solve_load_path
+from fenics_contact.verification.examples import BarOnCradle
 
 
 def test_one_big_step_is_cut_back_and_reaches_the_ten_step_answer():

@@ -9,14 +9,14 @@ from dolfinx import mesh
 from mpi4py import MPI
 
 from fenics_contact.cli import main
-from fenics_contact.contact import ContactSettings
-from fenics_contact.diagnostics import SolverSettings, Status
-from fenics_contact.examples import BarOnCradle, WedgeOnCorner
-from fenics_contact.materials import SaintVenantKirchhoff
-from fenics_contact.obstacles import RigidPlane
-from fenics_contact.problem import ContactProblem, SurfaceTraction
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.model.materials import SaintVenantKirchhoff
+from fenics_contact.model.obstacles import RigidPlane
+from fenics_contact.model.problem import ContactProblem, SurfaceTraction
 from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings, Status
 from fenics_contact.solvers.stepping import solve_load_path
+from fenics_contact.verification.examples import BarOnCradle, WedgeOnCorner
 
 EX1 = WedgeOnCorner()
 EX2 = BarOnCradle()

@@ -10,7 +10,7 @@ from pathlib import Path
 def _run(args: argparse.Namespace) -> int:
     from mpi4py import MPI
 
-    from fenics_contact.scene import load_scene
+    from fenics_contact.scene.schema import load_scene
 
     scene = load_scene(args.scene)  # validation first: no mesh, no forms yet
     out: Path = args.out or Path("results") / scene.name

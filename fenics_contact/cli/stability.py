@@ -11,9 +11,9 @@ from fenics_contact.cli.study import methods
 def _stability(args: argparse.Namespace) -> int:
     from mpi4py import MPI
 
-    from fenics_contact.io import write_csv, write_json
-    from fenics_contact.stability import full_grid, run_grid, select
-    from fenics_contact.sweep_plots import stability_plot
+    from fenics_contact.output.io import write_csv, write_json
+    from fenics_contact.output.sweep_plots import stability_plot
+    from fenics_contact.studies.stability import full_grid, run_grid, select
 
     out: Path = args.out
     rank0 = MPI.COMM_WORLD.rank == 0
@@ -50,8 +50,8 @@ def _names(text: str) -> list[str]:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``stability`` subcommand."""
-    from fenics_contact.scaling import DEFAULT_FORCE_RTOL
-    from fenics_contact.stability import METHODS
+    from fenics_contact.model.scaling import DEFAULT_FORCE_RTOL
+    from fenics_contact.studies.stability import METHODS
 
     cmd = sub.add_parser(
         "stability",

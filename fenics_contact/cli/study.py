@@ -33,11 +33,11 @@ def methods(text: str) -> list[str]:
 
 
 def _study(args: argparse.Namespace) -> int:
-    from fenics_contact.diagnostics import SolverSettings
-    from fenics_contact.examples import EXAMPLES
-    from fenics_contact.io import write_csv, write_json
-    from fenics_contact.plotting import iterations_against_r, residual_histories
-    from fenics_contact.study import paper_table, run_study
+    from fenics_contact.output.io import write_csv, write_json
+    from fenics_contact.output.plotting import iterations_against_r, residual_histories
+    from fenics_contact.solvers.diagnostics import SolverSettings
+    from fenics_contact.studies.study import paper_table, run_study
+    from fenics_contact.verification.examples import EXAMPLES
 
     example = EXAMPLES[args.example]()
     out: Path = args.out
@@ -69,7 +69,7 @@ def _study(args: argparse.Namespace) -> int:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``study`` subcommand."""
-    from fenics_contact.examples import EXAMPLES
+    from fenics_contact.verification.examples import EXAMPLES
 
     study = sub.add_parser(
         "study",

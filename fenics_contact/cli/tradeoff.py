@@ -11,9 +11,9 @@ from fenics_contact.cli.study import floats, methods
 def _tradeoff(args: argparse.Namespace) -> int:
     from mpi4py import MPI
 
-    from fenics_contact.io import write_csv, write_json
-    from fenics_contact.sweep_plots import tradeoff_plot
-    from fenics_contact.tradeoff import markdown_table, run_tradeoff
+    from fenics_contact.output.io import write_csv, write_json
+    from fenics_contact.output.sweep_plots import tradeoff_plot
+    from fenics_contact.studies.tradeoff import markdown_table, run_tradeoff
 
     out: Path = args.out
     rank0 = MPI.COMM_WORLD.rank == 0
@@ -58,7 +58,7 @@ def _scenes(text: str) -> list[str]:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``tradeoff`` subcommand."""
-    from fenics_contact.tradeoff import FULL_R, METHODS
+    from fenics_contact.studies.tradeoff import FULL_R, METHODS
 
     cmd = sub.add_parser(
         "tradeoff",

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from fenics_contact.diagnostics import SolverSettings
-from fenics_contact.problem import ContactProblem
+from fenics_contact.model.problem import ContactProblem
 from fenics_contact.solvers.auto import AutoStrategy
 from fenics_contact.solvers.base import SolveResult, Strategy
+from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.gnrm import GeneralizedNewton
 from fenics_contact.solvers.nua import NestedUzawa
 from fenics_contact.solvers.penalty import Penalty

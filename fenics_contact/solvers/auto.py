@@ -5,7 +5,7 @@ Example 2 analog: the complementarity residual min(lam + r g, 0) - lam
 multiplies every gap error by r, so an active-set change in the first
 Newton step makes the residual jump by ~r (the divergence test fires at
 r >= 1e8 E/h), and the round-off floor eps * r * g_scale of that residual
-exceeds any fixed tolerance (see :mod:`fenics_contact.scaling`).
+exceeds any fixed tolerance (see :mod:`fenics_contact.model.scaling`).
 
 This strategy
 
@@ -37,10 +37,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 from dolfinx.fem import petsc as fem_petsc
 
-from fenics_contact.diagnostics import ConvergenceMonitor, SolverSettings, Status
-from fenics_contact.problem import ContactProblem
-from fenics_contact.scaling import residual_floor
+from fenics_contact.model.problem import ContactProblem
+from fenics_contact.model.scaling import residual_floor
 from fenics_contact.solvers.base import SolveResult, newton_loop, timed
+from fenics_contact.solvers.diagnostics import ConvergenceMonitor, SolverSettings, Status
 from fenics_contact.solvers.newton import NewtonKernel
 
 

@@ -7,8 +7,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Protocol
 
-from fenics_contact.diagnostics import ConvergenceMonitor, SolverSettings, Status
-from fenics_contact.problem import ContactProblem, VariationalSystem
+from fenics_contact.model.problem import ContactProblem, VariationalSystem
+from fenics_contact.solvers.diagnostics import ConvergenceMonitor, SolverSettings, Status
 from fenics_contact.solvers.newton import NewtonKernel
 
 
@@ -17,7 +17,7 @@ class SolveResult:
     """Outcome of one nonlinear solve (one load increment).
 
     Attributes:
-        status: see :class:`fenics_contact.diagnostics.Status`.
+        status: see :class:`fenics_contact.solvers.diagnostics.Status`.
         iterations: Newton iterations (each one linear solve).
         updates: multiplier updates (Uzawa strategies; 0 otherwise).
         linear_solves: linear systems solved.

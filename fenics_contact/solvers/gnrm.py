@@ -7,7 +7,7 @@ The residual measure is the norm of (equilibrium, complementarity).
 
 from __future__ import annotations
 
-from fenics_contact.problem import ContactProblem, VariationalSystem
+from fenics_contact.model.problem import ContactProblem, VariationalSystem
 from fenics_contact.solvers.base import MonolithicNewton
 
 

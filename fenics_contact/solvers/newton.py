@@ -20,7 +20,7 @@ from dolfinx.fem import petsc as fem_petsc
 
 from petsc4py import PETSc
 
-from fenics_contact.problem import VariationalSystem
+from fenics_contact.model.problem import VariationalSystem
 from fenics_contact.solvers.linear import LinearSolverSettings, configure_ksp
 from fenics_contact.solvers.timing import KernelTimings, stopwatch
 

@@ -11,9 +11,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from fenics_contact.diagnostics import ConvergenceMonitor, SolverSettings, Status
-from fenics_contact.problem import ContactProblem
+from fenics_contact.model.problem import ContactProblem
 from fenics_contact.solvers.base import SolveResult, timed
+from fenics_contact.solvers.diagnostics import ConvergenceMonitor, SolverSettings, Status
 from fenics_contact.solvers.uzawa import UzawaBase
 
 

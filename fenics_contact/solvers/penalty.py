@@ -6,7 +6,7 @@ pressure / r.
 
 from __future__ import annotations
 
-from fenics_contact.problem import ContactProblem, VariationalSystem
+from fenics_contact.model.problem import ContactProblem, VariationalSystem
 from fenics_contact.solvers.base import MonolithicNewton
 
 

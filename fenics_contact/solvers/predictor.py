@@ -19,9 +19,9 @@ import numpy as np
 
 from mpi4py import MPI
 
-from fenics_contact.diagnostics import SolverSettings
-from fenics_contact.problem import ContactProblem
+from fenics_contact.model.problem import ContactProblem
 from fenics_contact.solvers.base import SolveResult, Strategy
+from fenics_contact.solvers.diagnostics import SolverSettings
 
 
 class Extrapolated:

@@ -13,8 +13,8 @@ import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 
-from fenics_contact.diagnostics import Status
 from fenics_contact.solvers.base import SolveResult, Strategy
+from fenics_contact.solvers.diagnostics import Status
 
 
 @dataclass

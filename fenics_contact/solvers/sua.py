@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from fenics_contact.diagnostics import ConvergenceMonitor
 from fenics_contact.solvers.base import SolveResult, newton_loop, timed
+from fenics_contact.solvers.diagnostics import ConvergenceMonitor
 from fenics_contact.solvers.uzawa import UzawaBase
 
 

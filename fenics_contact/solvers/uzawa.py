@@ -15,9 +15,9 @@ from dolfinx import fem
 
 from mpi4py import MPI
 
-from fenics_contact.contact import assemble_local
-from fenics_contact.diagnostics import SolverSettings
-from fenics_contact.problem import ContactProblem
+from fenics_contact.model.contact import assemble_local
+from fenics_contact.model.problem import ContactProblem
+from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.newton import NewtonKernel
 
 

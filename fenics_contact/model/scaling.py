@@ -25,7 +25,7 @@ import numpy as np
 
 from mpi4py import MPI
 
-from fenics_contact.problem import ContactProblem
+from fenics_contact.model.problem import ContactProblem
 
 #: Safety factor over eps * r * g_scale * ||A||. Measured on the Example 2
 #: analog: plain GNRM stalls at 0.3-0.5 times eps * r * g_scale * ||A||

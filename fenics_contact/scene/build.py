@@ -1,4 +1,4 @@
-"""Turn a validated :class:`~fenics_contact.scene.Scene` into a contact problem.
+"""Turn a validated :class:`~fenics_contact.scene.schema.Scene` into a contact problem.
 
 Builds the mesh (gmsh .geo/.msh or a generator), resolves facet tags by
 number or physical name, and creates only what the scene declares. Tag and
@@ -16,12 +16,12 @@ from dolfinx import mesh
 
 from mpi4py import MPI
 
-from fenics_contact.contact import ContactSettings
-from fenics_contact.materials import material
-from fenics_contact.meshing import mesh_on_rank
-from fenics_contact.obstacles import RigidBall, RigidObstacle, RigidPlane
-from fenics_contact.problem import ContactProblem, PrescribedDisplacement, SurfaceTraction
-from fenics_contact.scene import GENERATOR_TAGS, BoundarySpec, Scene, SceneError
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.model.materials import material
+from fenics_contact.model.obstacles import RigidBall, RigidObstacle, RigidPlane
+from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement, SurfaceTraction
+from fenics_contact.scene.meshing import mesh_on_rank
+from fenics_contact.scene.schema import GENERATOR_TAGS, BoundarySpec, Scene, SceneError
 
 
 @dataclass
@@ -157,7 +157,7 @@ def contact_facets(scene: Scene, body: BodyMesh, obstacle: RigidObstacle) -> np.
     spec = scene.contact
     if spec.tag is not None:
         return tagged_facets(body, scene, "contact", spec.tag)
-    from fenics_contact.candidates import detect_candidate_facets
+    from fenics_contact.model.candidates import detect_candidate_facets
 
     pushes = [abs(v) for d in scene.dirichlet for v in d.value if v is not None]
     return detect_candidate_facets(

@@ -19,10 +19,10 @@ from dolfinx import fem
 
 from mpi4py import MPI
 
-from fenics_contact.contact import ContactSettings, Quadrature
-from fenics_contact.diagnostics import SolverSettings, Status
-from fenics_contact.problem import ContactProblem
+from fenics_contact.model.contact import ContactSettings, Quadrature
+from fenics_contact.model.problem import ContactProblem
 from fenics_contact.solvers import PAPER_NAMES, make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings, Status
 from fenics_contact.solvers.stepping import PathResult, solve_load_path
 
 

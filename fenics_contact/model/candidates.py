@@ -22,7 +22,7 @@ from collections.abc import Sequence
 import numpy as np
 from dolfinx import mesh
 
-from fenics_contact.obstacles import RigidObstacle
+from fenics_contact.model.obstacles import RigidObstacle
 
 
 def boundary_facets(domain: mesh.Mesh) -> np.ndarray:

@@ -13,10 +13,10 @@ from dolfinx import mesh
 
 from mpi4py import MPI
 
-from fenics_contact.contact import ContactSettings
-from fenics_contact.materials import SaintVenantKirchhoff
-from fenics_contact.obstacles import RigidBall, RigidPlane
-from fenics_contact.problem import ContactProblem, PrescribedDisplacement
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.model.materials import SaintVenantKirchhoff
+from fenics_contact.model.obstacles import RigidBall, RigidPlane
+from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
 
 #: The paper's material for both examples.
 PAPER_E = 210.0

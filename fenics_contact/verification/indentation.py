@@ -18,10 +18,10 @@ from dolfinx import mesh
 
 from mpi4py import MPI
 
-from fenics_contact.contact import ContactSettings
-from fenics_contact.materials import Elastic, material
-from fenics_contact.obstacles import RigidBall
-from fenics_contact.problem import ContactProblem, PrescribedDisplacement
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.model.materials import Elastic, material
+from fenics_contact.model.obstacles import RigidBall
+from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
 
 
 def cells_for_dofs(dofs: float) -> int:

@@ -1,6 +1,6 @@
 """Stability at the extremes: a grid of hard cases, every one ending with a status.
 
-Each case is a scene (:mod:`fenics_contact.bench_scenes`) with one knob at
+Each case is a scene (:mod:`fenics_contact.verification.bench_scenes`) with one knob at
 an extreme: r from 1e-8 to 1e12 E/h (on the bar and on the Hertz cylinder),
 E from 1e-3 to 1e12 (displacement loading: forces scale with E), nu up to
 0.4999, 1/10/100 load steps, an initial penetration, grazing start, no
@@ -8,7 +8,7 @@ contact, full contact, a very coarse and a fine mesh.
 
 The stopping test is the same for every method and meaningful for any E:
 atol = max(force_rtol * E h^(d-1), round-off floor at r)
-(:func:`fenics_contact.scaling.scaled_atol`). A run never raises: an
+(:func:`fenics_contact.model.scaling.scaled_atol`). A run never raises: an
 exception becomes the status ``error`` with its message, and non-finite
 outputs the status ``nonfinite``. The step records of every run are written
 to ``<out>/cases/<case>__<method>.json`` after each converged step, so a
@@ -28,14 +28,14 @@ import numpy as np
 
 from mpi4py import MPI
 
-from fenics_contact.bench_scenes import BarScene, BlockScene, HertzScene
-from fenics_contact.contact import ContactSettings
-from fenics_contact.diagnostics import SolverSettings
-from fenics_contact.io import write_json
-from fenics_contact.scaling import DEFAULT_FORCE_RTOL, scaled_atol
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.model.scaling import DEFAULT_FORCE_RTOL, scaled_atol
+from fenics_contact.output.io import write_json
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.base import SolveResult
+from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.stepping import StepRecord, solve_load_path
+from fenics_contact.verification.bench_scenes import BarScene, BlockScene, HertzScene
 
 #: Methods the stability grid runs by default.
 METHODS = ("penalty", "sua", "nua", "gnrm", "auto")

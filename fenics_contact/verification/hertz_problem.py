@@ -1,8 +1,8 @@
 """The plane-strain Hertz validation problem: a half-cylinder pressed on a rigid plane.
 
 :class:`HertzCylinder` builds the contact problem on the graded half-disk of
-:func:`fenics_contact.meshing.hertz_half_disk`; :func:`measure_hertz`
-compares its converged state with :mod:`fenics_contact.hertz`.
+:func:`fenics_contact.scene.meshing.hertz_half_disk`; :func:`measure_hertz`
+compares its converged state with :mod:`fenics_contact.verification.hertz`.
 """
 
 from __future__ import annotations
@@ -14,19 +14,19 @@ from dolfinx import mesh
 
 from mpi4py import MPI
 
-from fenics_contact.contact import ContactSettings
-from fenics_contact.hertz import (
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.model.materials import LinearElastic
+from fenics_contact.model.obstacles import RigidPlane
+from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
+from fenics_contact.scene.meshing import CONTACT_TAG, TOP_TAG, hertz_half_disk
+from fenics_contact.verification.hertz import (
     ContactProfileFit,
     HertzSolution,
     fit_contact_profile,
     hertz_line_contact,
     relative_error,
 )
-from fenics_contact.hertz3d import HertzPointContact
-from fenics_contact.materials import LinearElastic
-from fenics_contact.meshing import CONTACT_TAG, TOP_TAG, hertz_half_disk
-from fenics_contact.obstacles import RigidPlane
-from fenics_contact.problem import ContactProblem, PrescribedDisplacement
+from fenics_contact.verification.hertz3d import HertzPointContact
 
 
 @dataclass(frozen=True)
@@ -179,7 +179,7 @@ def measure_hertz(problem: ContactProblem, cylinder: HertzCylinder) -> HertzComp
     """Compare the problem's current contact state with Hertz theory for its own load.
 
     The measured total contact force P sets the Hertz reference; the
-    half-width and peak come from :func:`fenics_contact.hertz.fit_contact_profile`
+    half-width and peak come from :func:`fenics_contact.verification.hertz.fit_contact_profile`
     over the nodes in contact, and the largest nodal pressure is compared too.
 
     Raises:

@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 from dolfinx import fem, plot
 
-from fenics_contact.io import SurfaceToBody
-from fenics_contact.obstacles import RigidBall, RigidPlane
-from fenics_contact.problem import ContactProblem
+from fenics_contact.model.obstacles import RigidBall, RigidPlane
+from fenics_contact.model.problem import ContactProblem
+from fenics_contact.output.io import SurfaceToBody
 
 
 def _obstacle_mesh(problem: ContactProblem, bounds: np.ndarray):

@@ -2,7 +2,7 @@
 
 A scene is checked completely before any mesh is made or form compiled:
 every mistake raises :class:`SceneError` naming the key, the bad value and
-the fix. Building the problem (:mod:`fenics_contact.scene_build`) creates
+the fix. Building the problem (:mod:`fenics_contact.scene.build`) creates
 only what the scene declares.
 
 Layout (units are the user's; be consistent)::
@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fenics_contact.materials import MATERIALS
+from fenics_contact.model.materials import MATERIALS
 
 METHODS = ("penalty", "sua", "nua", "gnrm", "auto")
 #: Fields the XDMF output can hold.

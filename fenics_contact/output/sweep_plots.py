@@ -14,8 +14,8 @@ import numpy as np
 from matplotlib.colors import ListedColormap
 
 from fenics_contact.solvers import PAPER_NAMES
-from fenics_contact.stability import CaseRecord
-from fenics_contact.tradeoff import ERROR_FLOOR, TradeoffRecord
+from fenics_contact.studies.stability import CaseRecord
+from fenics_contact.studies.tradeoff import ERROR_FLOOR, TradeoffRecord
 
 #: Colour of each status in the stability table.
 STATUS_COLOURS = {

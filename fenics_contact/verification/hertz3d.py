@@ -10,7 +10,7 @@ with E* = E / (1 - nu^2):
 - pressure         p(r) = p0 sqrt(1 - r^2 / a^2), r <= a.
 
 Pressures are magnitudes (>= 0). The fit of nodal pressures to
-p^2 = p0^2 (1 - r^2/a^2) is :func:`fenics_contact.hertz.fit_contact_profile`
+p^2 = p0^2 (1 - r^2/a^2) is :func:`fenics_contact.verification.hertz.fit_contact_profile`
 with the radial distance r as coordinate.
 """
 
@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fenics_contact.hertz import plane_strain_modulus
+from fenics_contact.verification.hertz import plane_strain_modulus
 
 
 @dataclass(frozen=True)

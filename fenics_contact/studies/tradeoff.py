@@ -8,7 +8,7 @@ relative L2 displacement error against a tight GNRM reference on the same
 mesh, and on the Hertz scene the peak-pressure error against Hertz theory.
 
 Stopping test for every method: atol = max(1e-10 E h^(d-1), round-off
-floor at r) (:func:`fenics_contact.scaling.scaled_atol`). The reference is
+floor at r) (:func:`fenics_contact.model.scaling.scaled_atol`). The reference is
 GNRM at r = 1 E/h with 1e-13 E h^(d-1).
 """
 
@@ -22,13 +22,13 @@ from dataclasses import asdict, dataclass
 
 from mpi4py import MPI
 
-from fenics_contact.bench_scenes import BarScene, HertzScene
-from fenics_contact.contact import ContactSettings
-from fenics_contact.diagnostics import SolverSettings, Status
-from fenics_contact.scaling import DEFAULT_FORCE_RTOL, scaled_atol
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.model.scaling import DEFAULT_FORCE_RTOL, scaled_atol
 from fenics_contact.solvers import PAPER_NAMES, make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings, Status
 from fenics_contact.solvers.stepping import solve_load_path
-from fenics_contact.study import relative_l2_error
+from fenics_contact.studies.study import relative_l2_error
+from fenics_contact.verification.bench_scenes import BarScene, HertzScene
 
 #: r values relative to E/h of the full sweep: 1e-4 ... 1e8, a decade apart.
 FULL_R = tuple(10.0**e for e in range(-4, 9))

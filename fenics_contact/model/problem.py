@@ -19,7 +19,7 @@ from dolfinx import default_scalar_type, fem, mesh
 
 from mpi4py import MPI
 
-from fenics_contact.contact import (
+from fenics_contact.model.contact import (
     CONTACT_TAG,
     ContactSettings,
     ContactSurface,
@@ -27,8 +27,8 @@ from fenics_contact.contact import (
     augmented_pressure,
     penalty_energy,
 )
-from fenics_contact.materials import Elastic
-from fenics_contact.obstacles import RigidObstacle
+from fenics_contact.model.materials import Elastic
+from fenics_contact.model.obstacles import RigidObstacle
 
 
 @dataclass(frozen=True)

@@ -18,9 +18,9 @@ from xml.etree import ElementTree
 import numpy as np
 from dolfinx import fem, io
 
-from fenics_contact.materials import von_mises
-from fenics_contact.problem import ContactProblem
-from fenics_contact.scene import FIELDS
+from fenics_contact.model.materials import von_mises
+from fenics_contact.model.problem import ContactProblem
+from fenics_contact.scene.schema import FIELDS
 
 
 def _clean(value: object) -> object:

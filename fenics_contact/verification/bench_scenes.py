@@ -4,18 +4,19 @@ Each scene is a frozen dataclass with ``steps``, ``label`` and
 ``build(settings, comm) -> ContactProblem``; every knob a sweep turns
 (material, mesh, initial gap, candidate facets) is a field.
 
-- :class:`BarScene`: the Example 2 analog (:class:`~fenics_contact.examples.BarOnCradle`)
+- :class:`BarScene`: the Example 2 analog
+  (:class:`~fenics_contact.verification.examples.BarOnCradle`)
   with free E, nu, law, mesh (nx, ny) and end gap (negative: initial
   penetration; 0: grazing; large: no contact).
 - :class:`HertzScene`: the Hertz half-cylinder
-  (:class:`~fenics_contact.hertz_problem.HertzCylinder`) with free E, nu and
+  (:class:`~fenics_contact.verification.hertz_problem.HertzCylinder`) with free E, nu and
   mesh sizes.
 - :class:`BlockScene`: a block pressed flat onto a rigid plane: every
   bottom node in contact (full contact), gap exactly 0 at the start.
 
 Candidate facets (``candidates``): ``"tag"`` the scene's own choice (the
 bar's lower face, the Hertz contact band, the block's lower face);
-``"detected"`` :func:`~fenics_contact.candidates.detect_candidate_facets`
+``"detected"`` :func:`~fenics_contact.model.candidates.detect_candidate_facets`
 with a margin that includes the body's largest prescribed displacement;
 ``"boundary"`` every exterior facet. Loads are prescribed displacements, so
 all forces scale with E.
@@ -31,14 +32,14 @@ from dolfinx import mesh
 
 from mpi4py import MPI
 
-from fenics_contact.candidates import boundary_facets, detect_candidate_facets
-from fenics_contact.contact import ContactSettings
-from fenics_contact.examples import PAPER_E, PAPER_NU
-from fenics_contact.hertz_problem import HertzCylinder, measure_hertz
-from fenics_contact.materials import material
-from fenics_contact.meshing import CONTACT_TAG, TOP_TAG, hertz_half_disk
-from fenics_contact.obstacles import RigidBall, RigidObstacle, RigidPlane
-from fenics_contact.problem import ContactProblem, PrescribedDisplacement
+from fenics_contact.model.candidates import boundary_facets, detect_candidate_facets
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.model.materials import material
+from fenics_contact.model.obstacles import RigidBall, RigidObstacle, RigidPlane
+from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
+from fenics_contact.scene.meshing import CONTACT_TAG, TOP_TAG, hertz_half_disk
+from fenics_contact.verification.examples import PAPER_E, PAPER_NU
+from fenics_contact.verification.hertz_problem import HertzCylinder, measure_hertz
 
 Candidates = Literal["tag", "detected", "boundary"]
 

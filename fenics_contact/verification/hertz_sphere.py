@@ -1,9 +1,9 @@
 """The 3D Hertz validation problem: one eighth of a sphere pressed on a rigid plane.
 
 :class:`HertzSphere` builds the contact problem on the graded octant of
-:func:`fenics_contact.meshing.hertz_sphere_octant` with symmetry conditions
+:func:`fenics_contact.scene.meshing.hertz_sphere_octant` with symmetry conditions
 on x = 0 and y = 0; :func:`measure_hertz_sphere` compares its converged state
-with :mod:`fenics_contact.hertz3d` at the force it transmits (four times the
+with :mod:`fenics_contact.verification.hertz3d` at the force it transmits (four times the
 octant's, the model being a quarter of the lower hemisphere).
 """
 
@@ -16,20 +16,20 @@ from dolfinx import mesh
 
 from mpi4py import MPI
 
-from fenics_contact.contact import ContactSettings
-from fenics_contact.hertz import fit_contact_profile
-from fenics_contact.hertz3d import hertz_point_contact
-from fenics_contact.hertz_problem import HertzComparison
-from fenics_contact.materials import Elastic, material
-from fenics_contact.meshing import (
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.model.materials import Elastic, material
+from fenics_contact.model.obstacles import RigidPlane
+from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
+from fenics_contact.scene.meshing import (
     CONTACT_TAG,
     SYMMETRY_X_TAG,
     SYMMETRY_Y_TAG,
     TOP_TAG,
     hertz_sphere_octant,
 )
-from fenics_contact.obstacles import RigidPlane
-from fenics_contact.problem import ContactProblem, PrescribedDisplacement
+from fenics_contact.verification.hertz import fit_contact_profile
+from fenics_contact.verification.hertz3d import hertz_point_contact
+from fenics_contact.verification.hertz_problem import HertzComparison
 
 #: Symmetry copies of the octant in the full lower hemisphere.
 COPIES = 4

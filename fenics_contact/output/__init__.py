@@ -1,0 +1,1 @@
+"""Output at the edge: XDMF fields, JSON and CSV records, pictures and plots."""

@@ -1,0 +1,1 @@
+"""Sweeps over methods and parameters: the paper's study, speed against accuracy, stability."""

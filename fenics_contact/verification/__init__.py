@@ -1,0 +1,1 @@
+"""Problems with known answers: analytic references and benchmark problems, each defined once."""
