@@ -84,7 +84,7 @@ writer.close()
 reference = reference_solution(example)
 records = []
 for r in (1.0, 10.0, 100.0, 1000.0, 10000.0):
-    record, _, _ = run_one(
+    record, _ = run_one(
         example, "gnrm", r, relative=False,
         settings=SolverSettings(atol=1e-8, max_iterations=500), reference=reference,
     )
@@ -108,7 +108,7 @@ if MPI.COMM_WORLD.rank == 0:
             "example": "paper-ex2 (bar on a cradle)",
             "method": "gnrm",
             "contact_patterns": patterns,
-            "runs": [rec.__dict__ for rec in records],
+            "runs": [rec.to_dict() for rec in records],
         },
     )
     (out / "table.md").write_text(table + "\n")

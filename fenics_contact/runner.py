@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -17,8 +16,7 @@ from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.base import SolveResult
 from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.linear import LinearSolverSettings
-from fenics_contact.solvers.predictor import Extrapolated
-from fenics_contact.solvers.stepping import PathResult, StepRecord, solve_load_path
+from fenics_contact.solvers.stepping import RunRecord, StepRecord, solve_load_path, start_record
 
 
 @dataclass
@@ -26,35 +24,25 @@ class RunOutcome:
     """What a run produced."""
 
     problem: ContactProblem
-    path: PathResult
+    path: RunRecord
     summary: dict
     out: Path
 
 
-def _summary(scene: Scene, problem: ContactProblem, path: PathResult | None, wall: float) -> dict:
-    steps = path.steps if path is not None else []
+def _summary(scene: Scene, record: RunRecord) -> dict:
+    """summary.json: the scene's identity and settings, then the run record."""
     return {
         "scene": scene.name,
         "scene_file": str(scene.path),
-        "status": path.status if path is not None else "running",
-        "method": scene.solver.method,
         "dimension": scene.dimension,
         "law": scene.law,
         "E": scene.E,
         "nu": scene.nu,
-        "r_absolute": problem.r_absolute,
-        "r_relative": problem.r_relative,
         "quadrature": scene.contact.quadrature,
         "predictor": scene.solver.predictor,
         "linear_solver": scene.solver.linear_solver,
-        "displacement_dofs": problem.V.dofmap.index_map.size_global * problem.V.dofmap.index_map_bs,
-        "multiplier_dofs": problem.surface.num_dofs,
         "load_steps": scene.solver.steps,
-        "steps_completed": sum(s.status == "converged" for s in steps),
-        "iterations": sum(s.iterations for s in steps),
-        "wall_s": wall,
-        "processes": problem.comm.size,
-        "steps": [s.to_dict() for s in steps],
+        **record.to_dict(),
     }
 
 
@@ -72,40 +60,34 @@ def run_scene(
     Each converged load step is written to the XDMF file and summary.json at
     once, so a failing step leaves the completed ones on disk.
     """
-    start = time.perf_counter()
     problem = build_problem(scene, comm)
     settings = SolverSettings(
         atol=scene.solver.atol, rtol=scene.solver.rtol,
         max_iterations=scene.solver.max_iterations,
     )
-    strategy = make_strategy(scene.solver.method, problem, settings)
-    strategy.observer = on_residual  # type: ignore[attr-defined]
-    if scene.solver.linear_solver == "iterative":
-        strategy.kernel.set_linear_solver(  # type: ignore[attr-defined]
-            LinearSolverSettings(kind="iterative")
-        )
-    if scene.solver.predictor == "extrapolate":
-        strategy = Extrapolated(strategy)
+    strategy = make_strategy(
+        scene.solver.method, problem, settings,
+        linear=LinearSolverSettings(kind=scene.solver.linear_solver),
+        observer=on_residual, predictor=scene.solver.predictor,
+    )
     writer = StepWriter(problem, out / "solution.xdmf", scene.fields)
-    done: list[StepRecord] = []
+    record = start_record(strategy)
 
     def finished(step: StepRecord) -> None:
         writer.write(step.load_factor)
-        done.append(step)
-        partial = PathResult("running", list(done))
         if comm.rank == 0:
-            write_json(out / "summary.json", _summary(scene, problem, partial, 0.0))
+            write_json(out / "summary.json", _summary(scene, record))
         if on_step is not None:
             on_step(step)
 
     try:
         path = solve_load_path(
             strategy, scene.solver.steps, max_cutbacks=scene.solver.max_cutbacks,
-            on_step=finished,
+            on_step=finished, record=record,
         )
     finally:
         writer.close()
-    summary = _summary(scene, problem, path, time.perf_counter() - start)
+    summary = _summary(scene, path)
     if comm.rank == 0:
         write_json(out / "summary.json", summary)
     draw = scene.pictures if pictures is None else pictures

@@ -114,3 +114,35 @@ def test_stopping_test_never_demands_less_than_the_round_off_floor():
     assert path.status == Status.MAX_ITERATIONS
     _, path, _ = solve(BAR, "gnrm", 1e10, divergence_factor=1e300)
     assert path.converged
+
+
+def test_auto_reports_residual_progress_through_every_stage():
+    """The observer hears every residual of every stage, with iterations counted over the solve."""
+    problem = BAR.build(ContactSettings(r=1e8, relative=True))
+    heard = []
+    strategy = make_strategy(
+        "auto", problem, SolverSettings(atol=scaled_atol(problem), max_iterations=60),
+        observer=lambda iterations, residual: heard.append((iterations, residual)),
+    )
+    problem.set_load(1.0 / BAR.steps)
+    result = strategy.solve()
+    assert result.converged
+    assert [r for _, r in heard] == result.residuals
+    counts = [i for i, _ in heard]
+    assert counts == sorted(counts) and counts[-1] == result.iterations
+
+
+def test_auto_fallback_kernels_use_the_configured_linear_solver():
+    from fenics_contact.solvers.linear import LinearSolverSettings
+
+    problem = BAR.build(ContactSettings(r=1.0, relative=True))
+    iterative = LinearSolverSettings(kind="iterative")
+    strategy = AutoStrategy(problem, SolverSettings(), linear=iterative)
+    problem.set_load(1.0 / BAR.steps)
+    settings = SolverSettings(atol=scaled_atol(problem))
+    from fenics_contact.solvers.auto import _Tally
+
+    assert strategy._penalty_start(settings, _Tally())
+    assert strategy.kernel.linear.kind == "iterative"
+    assert strategy._penalty.linear.kind == "iterative"
+    assert strategy._penalty.ksp.getType() == "gmres"

@@ -16,7 +16,7 @@ def test_tradeoff_command_writes_json_csv_table_and_plot(tmp_path):
                  "--meshes", "1", "--repeats", "1", "--out", str(tmp_path)])
     assert code == 0
     rows = read_csv(tmp_path / "tradeoff.csv")
-    columns = {"scene", "mesh", "dofs", "method", "r_relative", "status", "iterations",
+    columns = {"scene", "mesh", "displacement_dofs", "method", "r_relative", "status", "iterations",
                "linear_solves", "wall_s", "repeats", "max_penetration", "u_error", "p0_error",
                "pareto_u"}
     assert columns <= set(rows[0])
@@ -35,7 +35,7 @@ def test_stability_command_writes_csv_plot_and_step_records(tmp_path):
     assert code == 0
     rows = read_csv(tmp_path / "stability.csv")
     columns = {"case", "group", "method", "status", "iterations", "steps_completed",
-               "max_penetration", "contact_force", "max_abs_u", "atol", "switch_log"}
+               "max_penetration", "contact_force", "max_abs_u", "atol", "switches"}
     assert columns <= set(rows[0])
     status = {(r["case"], r["method"]): r["status"] for r in rows}
     assert status == {

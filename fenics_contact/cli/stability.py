@@ -37,7 +37,7 @@ def _stability(args: argparse.Namespace) -> int:
         cases, args.methods, out=out, progress=keep, max_iterations=args.max_iterations,
         max_cutbacks=args.max_cutbacks, force_rtol=args.force_rtol,
     )
-    write_json(out / "stability.json", [r.__dict__ for r in records])
+    write_json(out / "stability.json", [r.to_dict() for r in records])
     if rank0:
         stability_plot(records, out / "stability.png")
         print(f"\nWrote {out}/stability.csv, stability.json, stability.png and cases/*.json")

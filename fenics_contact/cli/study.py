@@ -58,7 +58,7 @@ def _study(args: argparse.Namespace) -> int:
     table = paper_table(records, limit=args.max_iterations)
     print()
     print(table)
-    write_json(out / "study.json", [r.__dict__ for r in records])
+    write_json(out / "study.json", [r.to_dict() for r in records])
     write_csv(out / "study.csv", [r.row() for r in records])
     (out / "table.md").write_text(table + "\n")
     residual_histories(records, out / "residuals.png")

@@ -103,6 +103,21 @@ class VariationalSystem:
 
 
 @dataclass(frozen=True)
+class ProblemState:
+    """A copy of the unknowns and the load factor, for undoing a failed increment.
+
+    Attributes:
+        u: displacement dof values (owned and ghost), length.
+        lam: multiplier dof values (owned and ghost), stress.
+        load_factor: the load factor the state belongs to.
+    """
+
+    u: np.ndarray
+    lam: np.ndarray
+    load_factor: float
+
+
+@dataclass(frozen=True)
 class ContactState:
     """Nodal contact diagnostics at the current iterate.
 
@@ -254,6 +269,17 @@ class ContactProblem:
             self._traction_constants.append((const, np.asarray(traction.value, float)))
             work += ufl.dot(const, self.u) * ds(TRACTION_TAG0 + i)
         return work
+
+    def snapshot(self) -> ProblemState:
+        """Copy the unknowns and the load factor (see :meth:`restore`)."""
+        return ProblemState(self.u.x.array.copy(), self.lam.x.array.copy(), self.load_factor)
+
+    def restore(self, state: ProblemState, *, load: bool = True) -> None:
+        """Put back a :meth:`snapshot`; ``load=False`` keeps the current load factor."""
+        self.u.x.array[:] = state.u
+        self.lam.x.array[:] = state.lam
+        if load:
+            self.set_load(state.load_factor)
 
     # -- systems handed to solvers -------------------------------------------
     def augmented_system(self) -> VariationalSystem:

@@ -12,7 +12,7 @@ import matplotlib.pyplot as plt
 from matplotlib.ticker import MaxNLocator
 
 from fenics_contact.solvers import PAPER_NAMES
-from fenics_contact.studies.study import RunRecord
+from fenics_contact.solvers.stepping import RunRecord
 
 
 def residual_histories(records: Sequence[RunRecord], path: Path) -> None:

@@ -4,11 +4,13 @@ from __future__ import annotations
 
 from fenics_contact.model.problem import ContactProblem
 from fenics_contact.solvers.auto import AutoStrategy
-from fenics_contact.solvers.base import SolveResult, Strategy
+from fenics_contact.solvers.base import Observer, SolveResult, Strategy
 from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.gnrm import GeneralizedNewton
+from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.nua import NestedUzawa
 from fenics_contact.solvers.penalty import Penalty
+from fenics_contact.solvers.predictor import Extrapolated
 from fenics_contact.solvers.sua import SimultaneousUzawa
 
 STRATEGIES: dict[str, type] = {
@@ -29,15 +31,41 @@ PAPER_NAMES = {
 }
 
 
-def make_strategy(name: str, problem: ContactProblem, settings: SolverSettings) -> Strategy:
-    """Build the strategy called ``name`` for ``problem``."""
+#: How a load step is started: from the last converged state, or extrapolated.
+PREDICTORS = ("previous", "extrapolate")
+
+
+def make_strategy(
+    name: str,
+    problem: ContactProblem,
+    settings: SolverSettings,
+    *,
+    linear: LinearSolverSettings | None = None,
+    observer: Observer | None = None,
+    predictor: str = "previous",
+) -> Strategy:
+    """Build the strategy called ``name`` for ``problem``, fully configured.
+
+    Args:
+        name: one of :data:`STRATEGIES`.
+        problem: the problem it solves (its current state is the start).
+        settings: stopping rules.
+        linear: linear solver of every Newton kernel the strategy uses
+            (direct MUMPS when None).
+        observer: called with (iterations, residual) at every residual check.
+        predictor: 'previous' starts each load step from the last converged
+            state; 'extrapolate' from the linear extrapolation of the last two.
+    """
     try:
         cls = STRATEGIES[name]
     except KeyError:
         raise ValueError(
             f"Unknown method {name!r}; choose one of {', '.join(STRATEGIES)}."
         ) from None
-    return cls(problem, settings)  # type: ignore[no-any-return]
+    if predictor not in PREDICTORS:
+        raise ValueError(f"Unknown predictor {predictor!r}; choose one of {', '.join(PREDICTORS)}.")
+    strategy: Strategy = cls(problem, settings, linear=linear, observer=observer)
+    return Extrapolated(strategy) if predictor == "extrapolate" else strategy
 
 
-__all__ = ["STRATEGIES", "SolveResult", "Strategy", "make_strategy"]
+__all__ = ["PREDICTORS", "STRATEGIES", "SolveResult", "Strategy", "make_strategy"]

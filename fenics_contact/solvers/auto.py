@@ -37,10 +37,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 from dolfinx.fem import petsc as fem_petsc
 
-from fenics_contact.model.problem import ContactProblem
+from fenics_contact.model.problem import ContactProblem, ProblemState
 from fenics_contact.model.scaling import residual_floor
-from fenics_contact.solvers.base import SolveResult, newton_loop, timed
+from fenics_contact.solvers.base import Observer, SolveResult, newton_loop, timed
 from fenics_contact.solvers.diagnostics import ConvergenceMonitor, SolverSettings, Status
+from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.newton import NewtonKernel
 
 
@@ -85,12 +86,17 @@ class AutoStrategy:
         self,
         problem: ContactProblem,
         settings: SolverSettings,
+        *,
+        linear: LinearSolverSettings | None = None,
+        observer: Observer | None = None,
         auto: AutoSettings | None = None,
     ) -> None:
         self.problem = problem
         self.settings = settings
+        self.linear = linear or LinearSolverSettings()
+        self.observer = observer
         self.auto = auto or AutoSettings()
-        self.kernel = NewtonKernel(problem.augmented_system())
+        self.kernel = NewtonKernel(problem.augmented_system(), linear=self.linear)
         self._penalty: NewtonKernel | None = None
 
     # -- public ------------------------------------------------------------------
@@ -145,7 +151,7 @@ class AutoStrategy:
     def _rung(self, tally: _Tally, settings: SolverSettings) -> Status:
         """Solve at the current r: GNRM, then line search, then penalty warm start."""
         p = self.problem
-        saved = (p.u.x.array.copy(), p.lam.x.array.copy())
+        saved = p.snapshot()
         status = self._newton(settings, tally, line_search=False)
         if status is Status.CONVERGED:
             return status
@@ -173,7 +179,7 @@ class AutoStrategy:
                 f"check at user r = {r_user:.3g}: residual {norm:.2e} <= {tolerance:.2e}"
             )
             return
-        saved = (p.u.x.array.copy(), p.lam.x.array.copy())
+        saved = p.snapshot()
         status = self._newton(settings, tally, line_search=True)
         tally.switches.append(
             f"check at user r = {r_user:.3g}: residual {norm:.2e} > {tolerance:.2e}; "
@@ -200,7 +206,7 @@ class AutoStrategy:
 
     def _newton(self, settings: SolverSettings, tally: _Tally, *, line_search: bool) -> Status:
         """Newton on the Alart-Curnier system, plain or with backtracking."""
-        monitor = ConvergenceMonitor(settings)
+        monitor = ConvergenceMonitor(settings, observer=self._progress(tally))
         if line_search:
             status, steps = self._line_search_loop(self.kernel, monitor)
         else:
@@ -245,9 +251,11 @@ class AutoStrategy:
         """Penalty solve at the current r, then lam = min(r g, 0); True on success."""
         p = self.problem
         if self._penalty is None:
-            self._penalty = NewtonKernel(p.penalty_system())
+            self._penalty = NewtonKernel(p.penalty_system(), linear=self.linear)
         p.lam.x.array[:] = 0.0
-        monitor = ConvergenceMonitor(replace(settings, rtol=max(settings.rtol, 1e-6)))
+        monitor = ConvergenceMonitor(
+            replace(settings, rtol=max(settings.rtol, 1e-6)), observer=self._progress(tally)
+        )
         status, steps = self._line_search_loop(self._penalty, monitor)
         tally.iterations += steps
         tally.residuals.extend(monitor.residuals)
@@ -257,9 +265,15 @@ class AutoStrategy:
         return True
 
     # -- helpers -----------------------------------------------------------------------
-    def _restore(self, saved: tuple[np.ndarray, np.ndarray]) -> None:
-        self.problem.u.x.array[:] = saved[0]
-        self.problem.lam.x.array[:] = saved[1]
+    def _progress(self, tally: _Tally) -> Observer | None:
+        """The observer, told the iterations of the whole solve (all stages)."""
+        if self.observer is None:
+            return None
+        observer, offset = self.observer, tally.iterations
+        return lambda iterations, residual: observer(offset + iterations, residual)
+
+    def _restore(self, saved: ProblemState) -> None:
+        self.problem.restore(saved, load=False)
 
     @staticmethod
     def _push(kernel: NewtonKernel) -> None:

@@ -9,6 +9,7 @@ from typing import Protocol
 
 from fenics_contact.model.problem import ContactProblem, VariationalSystem
 from fenics_contact.solvers.diagnostics import ConvergenceMonitor, SolverSettings, Status
+from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.newton import NewtonKernel
 
 
@@ -38,6 +39,10 @@ class SolveResult:
     def converged(self) -> bool:
         """True when the status is converged."""
         return self.status is Status.CONVERGED
+
+
+#: Progress callback: (Newton iterations so far in the solve, residual norm).
+Observer = Callable[[int, float], None]
 
 
 class Strategy(Protocol):
@@ -90,13 +95,19 @@ class MonolithicNewton:
     """Plain Newton on one system built by :meth:`build_system` (GNRM and PM)."""
 
     name = "newton"
-    #: Optional progress callback (iterations, residual), see ConvergenceMonitor.
-    observer: Callable[[int, float], None] | None = None
 
-    def __init__(self, problem: ContactProblem, settings: SolverSettings) -> None:
+    def __init__(
+        self,
+        problem: ContactProblem,
+        settings: SolverSettings,
+        *,
+        linear: LinearSolverSettings | None = None,
+        observer: Observer | None = None,
+    ) -> None:
         self.problem = problem
         self.settings = settings
-        self.kernel = NewtonKernel(self.build_system(problem))
+        self.observer = observer
+        self.kernel = NewtonKernel(self.build_system(problem), linear=linear)
 
     def build_system(self, problem: ContactProblem) -> VariationalSystem:
         """The residual blocks this strategy solves."""

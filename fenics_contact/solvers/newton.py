@@ -36,16 +36,11 @@ class NewtonKernel:
 
     Args:
         system: residual blocks, unknowns and boundary conditions.
-        linear_solver: LU package of the default direct solver (kept for
-            backward compatibility; ``linear`` overrides it).
-        linear: linear solver settings; direct LU with ``linear_solver`` when None.
+        linear: linear solver settings; direct LU (MUMPS) when None.
     """
 
     def __init__(
-        self,
-        system: VariationalSystem,
-        linear_solver: str = "mumps",
-        linear: LinearSolverSettings | None = None,
+        self, system: VariationalSystem, linear: LinearSolverSettings | None = None
     ) -> None:
         self.timings = KernelTimings()
         self.system = system
@@ -65,7 +60,7 @@ class NewtonKernel:
         self.A.setOptionsPrefix(f"{self._prefix}A_")
         self.ksp: PETSc.KSP | None = None
         self._keep: tuple = ()
-        self.set_linear_solver(linear or LinearSolverSettings(factor=linear_solver))
+        self.set_linear_solver(linear or LinearSolverSettings())
         self.linear_solves = 0
         self.residual_norm = np.inf
 

@@ -12,8 +12,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from fenics_contact.model.problem import ContactProblem
-from fenics_contact.solvers.base import SolveResult, timed
+from fenics_contact.solvers.base import Observer, SolveResult, timed
 from fenics_contact.solvers.diagnostics import ConvergenceMonitor, SolverSettings, Status
+from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.uzawa import UzawaBase
 
 
@@ -33,9 +34,12 @@ class NestedUzawa(UzawaBase):
         self,
         problem: ContactProblem,
         settings: SolverSettings,
+        *,
+        linear: LinearSolverSettings | None = None,
+        observer: Observer | None = None,
         nested: NestedSettings | None = None,
     ) -> None:
-        super().__init__(problem, settings)
+        super().__init__(problem, settings, linear=linear, observer=observer)
         self.nested = nested or NestedSettings()
 
     def solve(self) -> SolveResult:

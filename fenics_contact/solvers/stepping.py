@@ -9,6 +9,7 @@ with the failing status, and the steps already converged are kept (the
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
@@ -55,11 +56,46 @@ class StepRecord:
 
 
 @dataclass
-class PathResult:
-    """All load steps of one run."""
+class RunRecord:
+    """One run of a problem along its load path: the record every driver writes from.
+
+    The CLI's summary.json, the studies' tables and CSV files and the
+    benchmarks all read this record; a study that needs more columns
+    subclasses it (see :mod:`fenics_contact.studies`).
+
+    Attributes:
+        status: converged, the failing status of the last step, or ``error``
+            (an exception; ``message`` says which).
+        steps: one record per load step attempted.
+        method: strategy name.
+        r_absolute: r in stress per length.
+        r_relative: r divided by E/h.
+        displacement_dofs: global displacement unknowns.
+        multiplier_dofs: global multiplier unknowns.
+        processes: MPI ranks.
+        wall_s: wall-clock time of the load path (seconds).
+        error: relative L2 displacement error against a reference (NaN when none).
+        switches: decisions an adaptive strategy took, in order.
+        message: what went wrong when status is ``error``.
+    """
 
     status: str
-    steps: list[StepRecord]
+    steps: list[StepRecord] = field(default_factory=list)
+    method: str = ""
+    r_absolute: float = math.nan
+    r_relative: float = math.nan
+    displacement_dofs: int = 0
+    multiplier_dofs: int = 0
+    processes: int = 1
+    wall_s: float = 0.0
+    error: float = math.nan
+    switches: list[str] = field(default_factory=list)
+    message: str = ""
+
+    @property
+    def r(self) -> float:
+        """R in stress per length (the paper's tables)."""
+        return self.r_absolute
 
     @property
     def iterations(self) -> int:
@@ -77,16 +113,81 @@ class PathResult:
         return sum(s.linear_solves for s in self.steps)
 
     @property
+    def cutbacks(self) -> int:
+        """Increment halvings over the whole path."""
+        return sum(s.cutbacks for s in self.steps)
+
+    @property
+    def steps_completed(self) -> int:
+        """Load steps that converged."""
+        return sum(s.status == Status.CONVERGED for s in self.steps)
+
+    @property
+    def max_penetration(self) -> float:
+        """Largest nodal penetration at the last step attempted (length)."""
+        return self.steps[-1].max_penetration if self.steps else 0.0
+
+    @property
+    def contact_force(self) -> float:
+        """Normal contact force at the last step attempted (force)."""
+        return self.steps[-1].contact_force if self.steps else 0.0
+
+    @property
+    def residuals(self) -> list[list[float]]:
+        """Residual history of every solve, in order."""
+        return [h for s in self.steps for h in s.residuals]
+
+    @property
     def converged(self) -> bool:
         """True when every step converged."""
         return self.status == Status.CONVERGED
 
+    _DERIVED = (
+        "r",
+        "iterations", "updates", "linear_solves", "cutbacks", "steps_completed",
+        "max_penetration", "contact_force",
+    )
 
-def _absorb(record: StepRecord, result: SolveResult) -> None:
+    def row(self) -> dict[str, object]:
+        """Flat row for CSV and tables: fields, totals and r, no histories."""
+        d = {k: v for k, v in asdict(self).items() if k not in ("steps", "switches")}
+        d.update({k: getattr(self, k) for k in self._DERIVED})
+        d["switches"] = "; ".join(dict.fromkeys(s.split(":")[0] for s in self.switches))
+        return d
+
+    def to_dict(self) -> dict[str, object]:
+        """Everything, per-step records included, for JSON."""
+        d = self.row()
+        d["switches"] = list(self.switches)
+        d["steps"] = [s.to_dict() for s in self.steps]
+        return d
+
+
+#: The load-path result before the record gained its run context.
+PathResult = RunRecord
+
+
+def _absorb(record: StepRecord, result: SolveResult, run: RunRecord) -> None:
+    run.switches.extend(result.switches)
     record.iterations += result.iterations
     record.updates += result.updates
     record.linear_solves += result.linear_solves
     record.residuals.append(result.residuals)
+
+
+def start_record(strategy: Strategy) -> RunRecord:
+    """An empty record (status ``running``) carrying the strategy's and problem's context."""
+    problem = strategy.problem
+    V = problem.V
+    return RunRecord(
+        status="running",
+        method=strategy.name,
+        r_absolute=problem.r_absolute,
+        r_relative=problem.r_relative,
+        displacement_dofs=V.dofmap.index_map.size_global * V.dofmap.index_map_bs,
+        multiplier_dofs=problem.surface.num_dofs,
+        processes=problem.comm.size,
+    )
 
 
 def solve_load_path(
@@ -96,53 +197,63 @@ def solve_load_path(
     max_cutbacks: int = 4,
     on_step: Callable[[StepRecord], None] | None = None,
     on_iteration: Callable[[StepRecord, SolveResult], None] | None = None,
-) -> PathResult:
+    record: RunRecord | None = None,
+) -> RunRecord:
     """Drive the load factor 0 -> 1 in ``n_steps`` increments with cut-back.
 
     ``on_step`` is called after each converged step (write results there);
-    ``on_iteration`` after each solve attempt (progress display).
+    ``on_iteration`` after each solve attempt (progress display). The steps
+    go into ``record`` as they finish (a fresh :func:`start_record` when
+    None), so a caller holding it sees the run grow; it is returned with its
+    final status and wall time.
     """
     if n_steps < 1:
         raise ValueError(f"The number of load steps must be >= 1, got {n_steps}.")
     problem = strategy.problem
-    records: list[StepRecord] = []
+    run = start_record(strategy) if record is None else record
+    run_start = time.perf_counter()
     t = problem.load_factor
     for k in range(1, n_steps + 1):
         target = k / n_steps
-        record = StepRecord(step=k, load_factor=target, status=Status.CONVERGED.value)
+        if target <= t + 1e-14:
+            continue  # reached before (a resumed path)
+        step = StepRecord(step=k, load_factor=target, status=Status.CONVERGED.value)
         start = time.perf_counter()
         increment = target - t
         halvings = 0
         while t < target - 1e-14:
             t_try = min(t + increment, target)
-            saved = (problem.u.x.array.copy(), problem.lam.x.array.copy())
+            saved = problem.snapshot()
             problem.set_load(t_try)
             result = strategy.solve()
-            _absorb(record, result)
+            _absorb(step, result, run)
             if on_iteration is not None:
-                on_iteration(record, result)
+                on_iteration(step, result)
             if result.converged:
                 t = t_try
                 halvings = 0
                 continue
-            problem.u.x.array[:] = saved[0]
-            problem.lam.x.array[:] = saved[1]
-            problem.set_load(t)
-            record.cutbacks += 1
+            problem.restore(saved)
+            step.cutbacks += 1
             halvings += 1
             if halvings > max_cutbacks:
-                record.status = result.status.value
-                record.load_factor = t
+                step.status = result.status.value
+                step.load_factor = t
                 break
             increment /= 2
-        record.wall_s = time.perf_counter() - start
+        step.wall_s = time.perf_counter() - start
         state = problem.contact_state()
-        record.active_count = state.active_count
-        record.max_penetration = state.max_penetration
-        record.contact_force = state.contact_force
-        records.append(record)
-        if record.status != Status.CONVERGED:
-            return PathResult(record.status, records)
+        step.active_count = state.active_count
+        step.max_penetration = state.max_penetration
+        step.contact_force = state.contact_force
+        run.steps.append(step)
+        run.wall_s += time.perf_counter() - run_start
+        run_start = time.perf_counter()
+        if step.status != Status.CONVERGED:
+            run.status = step.status
+            return run
         if on_step is not None:
-            on_step(record)
-    return PathResult(Status.CONVERGED.value, records)
+            on_step(step)
+    run.status = Status.CONVERGED.value
+    run.wall_s += time.perf_counter() - run_start
+    return run

@@ -9,7 +9,6 @@ complementarity lam - min(lam + r g, 0)).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 
 from dolfinx import fem
 
@@ -17,7 +16,9 @@ from mpi4py import MPI
 
 from fenics_contact.model.contact import assemble_local
 from fenics_contact.model.problem import ContactProblem
+from fenics_contact.solvers.base import Observer
 from fenics_contact.solvers.diagnostics import SolverSettings
+from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.newton import NewtonKernel
 
 
@@ -25,13 +26,19 @@ class UzawaBase:
     """Primal Newton kernel plus the complementarity residual."""
 
     name = "uzawa"
-    #: Optional progress callback (iterations, residual), see ConvergenceMonitor.
-    observer: Callable[[int, float], None] | None = None
 
-    def __init__(self, problem: ContactProblem, settings: SolverSettings) -> None:
+    def __init__(
+        self,
+        problem: ContactProblem,
+        settings: SolverSettings,
+        *,
+        linear: LinearSolverSettings | None = None,
+        observer: Observer | None = None,
+    ) -> None:
         self.problem = problem
         self.settings = settings
-        self.kernel = NewtonKernel(problem.primal_system())
+        self.observer = observer
+        self.kernel = NewtonKernel(problem.primal_system(), linear=linear)
         self._complementarity = fem.form(
             problem.complementarity_residual(), entity_maps=problem.surface.entity_maps
         )

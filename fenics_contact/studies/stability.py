@@ -21,7 +21,7 @@ import math
 import time
 import traceback
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -32,9 +32,8 @@ from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.scaling import DEFAULT_FORCE_RTOL, scaled_atol
 from fenics_contact.output.io import write_json
 from fenics_contact.solvers import make_strategy
-from fenics_contact.solvers.base import SolveResult
 from fenics_contact.solvers.diagnostics import SolverSettings
-from fenics_contact.solvers.stepping import StepRecord, solve_load_path
+from fenics_contact.solvers.stepping import RunRecord, StepRecord, solve_load_path, start_record
 from fenics_contact.verification.bench_scenes import BarScene, BlockScene, HertzScene
 
 #: Methods the stability grid runs by default.
@@ -102,37 +101,21 @@ def select(cases: Sequence[StabilityCase], names: Sequence[str] | None) -> list[
 
 
 @dataclass
-class CaseRecord:
-    """Outcome of one (case, method) run; every number finite."""
+class CaseRecord(RunRecord):
+    """Outcome of one (case, method) run: the run record plus the case; every number finite."""
 
-    case: str
-    group: str
-    method: str
-    status: str
-    r_relative: float
-    r_absolute: float
-    E: float
-    nu: float
-    load_steps: int
-    steps_completed: int
-    iterations: int
-    linear_solves: int
-    updates: int
-    cutbacks: int
-    max_penetration: float
-    contact_force: float
-    max_abs_u: float
-    atol: float
-    wall_s: float
-    switches: int = 0
-    switch_log: list[str] = field(default_factory=list)
-    message: str = ""
+    case: str = ""
+    group: str = ""
+    E: float = 0.0
+    nu: float = 0.0
+    load_steps: int = 0
+    max_abs_u: float = 0.0
+    atol: float = 0.0
 
     def row(self) -> dict[str, object]:
-        """Flat CSV row (the switch log shortened to its distinct kinds)."""
-        d = asdict(self)
-        kinds = dict.fromkeys(s.split(":")[0] for s in self.switch_log)
-        d["switch_log"] = "; ".join(kinds)
+        """Flat row; no ``error`` column (the grid has no reference solutions)."""
+        d = super().row()
+        d.pop("error")
         return d
 
 
@@ -153,60 +136,53 @@ def run_case(
     """Run one method on one case; never raises for a solver or model failure."""
     scene = case.scene
     record = CaseRecord(
-        case=case.name, group=case.group, method=method, status=ERROR, r_relative=case.r,
-        r_absolute=0.0, E=float(getattr(scene, "E", 0.0)), nu=float(getattr(scene, "nu", 0.0)),
-        load_steps=case.steps, steps_completed=0, iterations=0, linear_solves=0, updates=0,
-        cutbacks=0, max_penetration=0.0, contact_force=0.0, max_abs_u=0.0, atol=0.0, wall_s=0.0,
+        status=ERROR, method=method, r_relative=case.r, r_absolute=0.0, case=case.name,
+        group=case.group,
+        E=float(getattr(scene, "E", 0.0)), nu=float(getattr(scene, "nu", 0.0)),
+        load_steps=case.steps,
     )
     steps_file = None if out is None else out / "cases" / f"{case.name}__{method}.json"
-    done: list[dict] = []
     start = time.perf_counter()
+
+    def keep(_: StepRecord) -> None:
+        if steps_file is not None:
+            write_json(steps_file, {"case": case.name, "method": method,
+                                    "steps": [s.to_dict() for s in record.steps]})
+
     try:
         problem = scene.build(ContactSettings(r=case.r, relative=True), comm)
-        record.r_absolute = problem.r_absolute
-        record.atol = scaled_atol(problem, force_rtol)
-        settings = SolverSettings(atol=record.atol, max_iterations=max_iterations)
-        strategy = make_strategy(method, problem, settings)
-
-        def keep(step: StepRecord) -> None:
-            done.append(step.to_dict())
-            if steps_file is not None:
-                write_json(steps_file, {"case": case.name, "method": method, "steps": done})
-
-        def note(_: StepRecord, result: SolveResult) -> None:
-            record.switch_log.extend(result.switches)
-
-        path = solve_load_path(
-            strategy, case.steps, max_cutbacks=max_cutbacks, on_step=keep, on_iteration=note
+        atol = scaled_atol(problem, force_rtol)
+        strategy = make_strategy(
+            method, problem, SolverSettings(atol=atol, max_iterations=max_iterations)
         )
-        state = problem.contact_state()
+        record = CaseRecord(
+            **{**vars(start_record(strategy)), **_case_fields(record)}, atol=atol
+        )
+        solve_load_path(
+            strategy, case.steps, max_cutbacks=max_cutbacks, on_step=keep, record=record
+        )
         local_u = float(np.max(np.abs(problem.u.x.array), initial=0.0))
         record.max_abs_u = comm.allreduce(local_u, op=MPI.MAX)
-        record.status = path.status
-        record.iterations = path.iterations
-        record.linear_solves = path.linear_solves
-        record.updates = path.updates
-        record.cutbacks = sum(s.cutbacks for s in path.steps)
-        record.steps_completed = len(done)
-        record.max_penetration = state.max_penetration
-        record.contact_force = state.contact_force
-        record.switches = len(record.switch_log)
-        if not _finite(record.max_abs_u, state.max_penetration, state.contact_force):
+        if not _finite(record.max_abs_u, record.max_penetration, record.contact_force):
             record.status = NONFINITE
-            record.max_abs_u = record.max_penetration = record.contact_force = 0.0
+            record.max_abs_u = 0.0
+            for step in record.steps:
+                step.max_penetration = step.contact_force = 0.0
     except Exception as exc:
         record.status = ERROR
         record.message = f"{type(exc).__name__}: {exc}".splitlines()[0][:200]
-        record.steps_completed = len(done)
         if comm.rank == 0:
             traceback.print_exc()
     record.wall_s = time.perf_counter() - start
     if steps_file is not None:
-        write_json(
-            steps_file,
-            {"case": case.name, "method": method, "status": record.status, "steps": done},
-        )
+        write_json(steps_file, {"case": case.name, "method": method, "status": record.status,
+                                "steps": [s.to_dict() for s in record.steps]})
     return record
+
+
+def _case_fields(record: CaseRecord) -> dict[str, object]:
+    """The case's own fields of a record (not the run's)."""
+    return {k: getattr(record, k) for k in ("case", "group", "E", "nu", "load_steps")}
 
 
 def run_grid(

@@ -9,9 +9,7 @@ penetration and the displacement error against a tight GNRM reference.
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
 
 import numpy as np
 import ufl
@@ -23,7 +21,7 @@ from fenics_contact.model.contact import ContactSettings, Quadrature
 from fenics_contact.model.problem import ContactProblem
 from fenics_contact.solvers import PAPER_NAMES, make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings, Status
-from fenics_contact.solvers.stepping import PathResult, solve_load_path
+from fenics_contact.solvers.stepping import RunRecord, solve_load_path
 
 
 class Example:
@@ -34,31 +32,6 @@ class Example:
     def build(self, settings: ContactSettings, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProblem:
         """Create the problem."""
         raise NotImplementedError
-
-
-@dataclass
-class RunRecord:
-    """One (method, r) run of a study."""
-
-    method: str
-    r: float
-    r_relative: float
-    status: str
-    iterations: int
-    updates: int
-    linear_solves: int
-    wall_s: float
-    max_penetration: float
-    error: float
-    contact_force: float
-    steps_completed: int
-    residuals: list[list[float]] = field(default_factory=list)
-
-    def row(self) -> dict[str, object]:
-        """Flat row for CSV (no histories)."""
-        d = dict(self.__dict__)
-        d.pop("residuals")
-        return d
 
 
 def relative_l2_error(u: fem.Function, reference: np.ndarray) -> float:
@@ -102,36 +75,14 @@ def run_one(
     reference: np.ndarray | None = None,
     max_cutbacks: int = 0,
     comm: MPI.Comm = MPI.COMM_WORLD,
-) -> tuple[RunRecord, ContactProblem, PathResult]:
+) -> tuple[RunRecord, ContactProblem]:
     """Solve the example once with one method and one r."""
     problem = example.build(ContactSettings(r=r, relative=relative, quadrature=quadrature), comm)
     strategy = make_strategy(method, problem, settings)
-    start = time.perf_counter()
-    path = solve_load_path(strategy, example.steps, max_cutbacks=max_cutbacks)
-    wall = time.perf_counter() - start
-    last = path.steps[-1]
-    done = sum(s.status == Status.CONVERGED for s in path.steps)
-    error = (
-        relative_l2_error(problem.u, reference)
-        if reference is not None and path.converged
-        else math.nan
-    )
-    record = RunRecord(
-        method=method,
-        r=problem.r_absolute,
-        r_relative=problem.r_relative,
-        status=path.status,
-        iterations=path.iterations,
-        updates=path.updates,
-        linear_solves=path.linear_solves,
-        wall_s=wall,
-        max_penetration=last.max_penetration,
-        error=error,
-        contact_force=last.contact_force,
-        steps_completed=done,
-        residuals=[h for s in path.steps for h in s.residuals],
-    )
-    return record, problem, path
+    record = solve_load_path(strategy, example.steps, max_cutbacks=max_cutbacks)
+    if reference is not None and record.converged:
+        record.error = relative_l2_error(problem.u, reference)
+    return record, problem
 
 
 def run_study(
@@ -150,7 +101,7 @@ def run_study(
     records = []
     for method in methods:
         for r in r_values:
-            record, _, _ = run_one(
+            record, _ = run_one(
                 example, method, r, relative=relative, settings=settings,
                 quadrature=quadrature, reference=reference,
             )

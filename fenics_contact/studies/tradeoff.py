@@ -16,9 +16,8 @@ from __future__ import annotations
 
 import math
 import statistics
-import time
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 from mpi4py import MPI
 
@@ -26,7 +25,7 @@ from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.scaling import DEFAULT_FORCE_RTOL, scaled_atol
 from fenics_contact.solvers import PAPER_NAMES, make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings, Status
-from fenics_contact.solvers.stepping import solve_load_path
+from fenics_contact.solvers.stepping import RunRecord, solve_load_path, start_record
 from fenics_contact.studies.study import relative_l2_error
 from fenics_contact.verification.bench_scenes import BarScene, HertzScene
 
@@ -50,31 +49,29 @@ def scene_meshes(name: str, count: int = 3) -> list[object]:
 
 
 @dataclass
-class TradeoffRecord:
-    """One (scene, mesh, method, r) point of the trade-off."""
+class TradeoffRecord(RunRecord):
+    """One (scene, mesh, method, r) point of the trade-off: the run record plus its place.
 
-    scene: str
-    mesh: str
-    dofs: int
-    multiplier_dofs: int
-    method: str
-    r_relative: float
-    r_absolute: float
-    status: str
-    iterations: int
-    linear_solves: int
-    updates: int
-    wall_s: float
-    repeats: int
-    max_penetration: float
-    u_error: float
-    p0_error: float
+    ``error`` is the displacement error against the GNRM reference on the
+    same mesh; ``p0_error`` the Hertz peak-pressure error (NaN off Hertz);
+    ``wall_s`` the median over ``repeats`` runs.
+    """
+
+    scene: str = ""
+    mesh: str = ""
+    repeats: int = 1
+    p0_error: float = math.nan
     pareto_u: bool = False
     pareto_p0: bool = False
 
+    @property
+    def u_error(self) -> float:
+        """Relative L2 displacement error against the reference."""
+        return self.error
+
     def row(self) -> dict[str, object]:
-        """Flat row for CSV."""
-        return asdict(self)
+        """Flat row, with the displacement error also named ``u_error``."""
+        return {**super().row(), "u_error": self.error}
 
 
 def reference_dofs(scene: object, comm: MPI.Comm = MPI.COMM_WORLD) -> object:
@@ -106,24 +103,20 @@ def run_point(
         settings = SolverSettings(atol=scaled_atol(problem, force_rtol),
                                   max_iterations=max_iterations)
         strategy = make_strategy(method, problem, settings)
-        start = time.perf_counter()
-        path = solve_load_path(strategy, scene.steps, max_cutbacks=0)
-        times.append(time.perf_counter() - start)
-        if not path.converged:
+        record = TradeoffRecord(
+            **vars(start_record(strategy)), scene=scene_name, mesh=scene.label
+        )
+        solve_load_path(strategy, scene.steps, max_cutbacks=0, record=record)
+        times.append(record.wall_s)
+        if not record.converged:
             break
-    ok = path.status == Status.CONVERGED
-    u_error = relative_l2_error(problem.u, reference) if ok and reference is not None else math.nan
-    p0_error = math.nan
-    if ok and hasattr(scene, "peak_pressure_error"):
-        p0_error = abs(scene.peak_pressure_error(problem))
-    return TradeoffRecord(
-        scene=scene_name, mesh=scene.label, dofs=problem.V.dofmap.index_map.size_global * 2,
-        multiplier_dofs=problem.surface.num_dofs, method=method, r_relative=r,
-        r_absolute=problem.r_absolute, status=path.status, iterations=path.iterations,
-        linear_solves=path.linear_solves, updates=path.updates,
-        wall_s=statistics.median(times), repeats=len(times),
-        max_penetration=path.steps[-1].max_penetration, u_error=u_error, p0_error=p0_error,
-    )
+    record.repeats = len(times)
+    record.wall_s = statistics.median(times)
+    if record.converged and reference is not None:
+        record.error = relative_l2_error(problem.u, reference)
+    if record.converged and hasattr(scene, "peak_pressure_error"):
+        record.p0_error = abs(scene.peak_pressure_error(problem))
+    return record
 
 
 def run_tradeoff(
