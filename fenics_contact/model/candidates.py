@@ -18,6 +18,7 @@ Gaps are measured in the reference configuration with
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Literal
 
 import numpy as np
 from dolfinx import mesh
@@ -82,3 +83,30 @@ def detect_candidate_facets(
         obstacle.point.value[:] = home
     near = (closest < reach).reshape(nodes.shape).any(axis=1)
     return np.sort(facets[near])
+
+
+#: How a problem picks its candidate facets: its own tag, detection along the
+#: obstacle's path, or every exterior facet.
+CandidateMode = Literal["tag", "detected", "boundary"]
+
+
+def choose_candidates(
+    domain: mesh.Mesh,
+    obstacle: RigidObstacle,
+    tagged: np.ndarray,
+    mode: CandidateMode,
+    reach: float,
+) -> np.ndarray:
+    """Candidate facets by ``mode``; ``reach`` bounds the body's own displacement (length).
+
+    'tag' returns ``tagged`` (the problem's own choice), 'detected' the
+    facets :func:`detect_candidate_facets` finds for a fixed obstacle with
+    margin ``reach``, 'boundary' every exterior facet.
+    """
+    if mode == "tag":
+        return tagged
+    if mode == "boundary":
+        return boundary_facets(domain)
+    if mode == "detected":
+        return detect_candidate_facets(domain, obstacle, None, 0.0, displacement_bound=reach)
+    raise ValueError(f"Unknown candidate mode {mode!r}; use 'tag', 'detected' or 'boundary'.")

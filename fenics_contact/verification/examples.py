@@ -1,4 +1,4 @@
-"""Ready-made problems: the paper's examples (analogs) and Hertz contact.
+"""The paper's examples (analogs) that the ``study`` command knows.
 
 The paper's Figures 1 and 2 are not available; the geometry of each analog
 is chosen here and documented in its docstring.
@@ -15,76 +15,9 @@ from mpi4py import MPI
 
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import SaintVenantKirchhoff
-from fenics_contact.model.obstacles import RigidBall, RigidPlane
+from fenics_contact.model.obstacles import RigidPlane
 from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
-
-#: The paper's material for both examples.
-PAPER_E = 210.0
-PAPER_NU = 0.3
-
-
-@dataclass(frozen=True)
-class BarOnCradle:
-    """Example 2 analog: a bar pushed into a rigid cylindrical cradle.
-
-    A plane-strain bar [-L/2, L/2] x [0, H] of ``nx`` x ``ny`` bilinear
-    quadrilaterals (6 x 2: 12 elements, 7 contact nodes on its lower face)
-    hangs a distance ``end_gap`` above a rigid cradle: the inside of a circle
-    of radius ``radius`` whose lowest point is below the bar's centre. The
-    middle third of the top face is driven down by ``push`` (and held
-    horizontally) in equal increments.
-
-    What happens (SVK, E = 210, nu = 0.3, r = 100; 10 steps): the bar's end
-    corners touch the cradle first; the bar bends and the gaps close toward
-    the centre until the whole lower face is in contact; as the centre is
-    pressed further the ends lift off again: gaps open near the
-    extremities while the centre stays closed, the pattern the paper
-    describes.
-    """
-
-    length: float = 6.0
-    height: float = 1.0
-    nx: int = 6
-    ny: int = 2
-    radius: float = 10.0
-    end_gap: float = 0.02
-    push: float = 0.8
-    steps: int = 10
-
-    def cradle_centre(self) -> tuple[float, float]:
-        """Centre of the cradle circle: its arc passes end_gap below the bar's corners."""
-        half = self.length / 2
-        return 0.0, -self.end_gap + float(np.sqrt(self.radius**2 - half**2))
-
-    def build(
-        self,
-        settings: ContactSettings,
-        comm: MPI.Comm = MPI.COMM_WORLD,
-    ) -> ContactProblem:
-        """Create the mesh and the contact problem."""
-        half = self.length / 2
-        domain = mesh.create_rectangle(
-            comm,
-            [np.array([-half, 0.0]), np.array([half, self.height])],
-            [self.nx, self.ny],
-            mesh.CellType.quadrilateral,
-        )
-        fdim = domain.topology.dim - 1
-        bottom = mesh.locate_entities_boundary(domain, fdim, lambda x: np.isclose(x[1], 0.0))
-        punch = mesh.locate_entities_boundary(
-            domain,
-            fdim,
-            lambda x: np.isclose(x[1], self.height) & (np.abs(x[0]) <= half / 3 + 1e-9),
-        )
-        cradle = RigidBall(domain, self.cradle_centre(), self.radius, inside=True)
-        return ContactProblem(
-            domain,
-            SaintVenantKirchhoff(E=PAPER_E, nu=PAPER_NU),
-            cradle,
-            bottom,
-            settings,
-            prescribed=[PrescribedDisplacement(punch, (0.0, -self.push))],
-        )
+from fenics_contact.verification.bar import PAPER_E, PAPER_NU, BarOnCradle
 
 
 @dataclass(frozen=True)

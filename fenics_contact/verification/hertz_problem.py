@@ -14,6 +14,7 @@ from dolfinx import mesh
 
 from mpi4py import MPI
 
+from fenics_contact.model.candidates import CandidateMode, choose_candidates
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import LinearElastic
 from fenics_contact.model.obstacles import RigidPlane
@@ -59,6 +60,9 @@ class HertzCylinder:
             ``h_far`` (length).
         contact_band: candidate contact facets have midpoints with
             y < contact_band * R.
+        steps: load steps.
+        candidates: 'tag' (the arc within the contact band), 'detected'
+            (along the plane's path) or 'boundary' (every exterior facet).
     """
 
     radius: float = 1.0
@@ -70,6 +74,13 @@ class HertzCylinder:
     fine_radius: float = 0.1
     coarse_radius: float = 0.5
     contact_band: float = 0.02
+    steps: int = 4
+    candidates: CandidateMode = "tag"
+
+    @property
+    def label(self) -> str:
+        """Mesh label for tables."""
+        return f"h={self.h_contact:g}"
 
     def material(self) -> LinearElastic:
         """The small-strain law of the body."""
@@ -100,9 +111,10 @@ class HertzCylinder:
         fdim = domain.topology.dim - 1
         arc = tags.find(CONTACT_TAG)
         midpoints = mesh.compute_midpoints(domain, fdim, arc)
-        candidates = arc[midpoints[:, 1] < self.contact_band * self.radius]
+        band = arc[midpoints[:, 1] < self.contact_band * self.radius]
         top = tags.find(TOP_TAG)
         plane = RigidPlane(domain, point=(0.0, 0.0), normal=(0.0, 1.0))
+        candidates = choose_candidates(domain, plane, band, self.candidates, self.push)
         return ContactProblem(
             domain,
             self.material(),
@@ -111,6 +123,13 @@ class HertzCylinder:
             settings,
             prescribed=[PrescribedDisplacement(top, (0.0, -self.push))],
         )
+
+    def peak_pressure_error(self, problem: ContactProblem) -> float:
+        """Relative error of the fitted peak pressure against Hertz (NaN if not measurable)."""
+        try:
+            return float(measure_hertz(problem, self).p0_error)
+        except ValueError:
+            return float("nan")
 
 
 def contact_profile(problem: ContactProblem) -> tuple[np.ndarray, np.ndarray]:
