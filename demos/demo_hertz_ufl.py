@@ -67,13 +67,15 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from mpi4py import MPI
-from petsc4py import PETSc
 
 import fenics_contact  # noqa: F401  (loads the DOLFINx wheel's libraries first)
+
+# isort: split
 import dolfinx
 import dolfinx.fem.petsc
 import ufl
 from dolfinx import default_scalar_type, fem, la, mesh
+
 from fenics_contact.scene.meshing import CONTACT_TAG, TOP_TAG, mesh_on_rank
 from fenics_contact.verification.hertz import (
     fit_contact_profile,
@@ -87,7 +89,15 @@ parser.add_argument(
     help="output folder (default: results/hertz_ufl)",
 )
 parser.add_argument("--steps", type=int, default=4, help="load steps (default: 4)")
+parser.add_argument(
+    "--max-iterations", type=int, default=30,
+    help="Newton iterations allowed per load step (default: 30)",
+)
 args, _ = parser.parse_known_args()  # tolerate a notebook kernel's own arguments
+if args.steps < 1 or args.max_iterations < 1:
+    parser.error(
+        f"--steps ({args.steps}) and --max-iterations ({args.max_iterations}) must be >= 1."
+    )
 
 comm = MPI.COMM_WORLD
 
@@ -325,7 +335,7 @@ problem = dolfinx.fem.petsc.NonlinearProblem(
         "snes_atol": 1e-10,
         "snes_rtol": 0.0,
         "snes_stol": 0.0,
-        "snes_max_it": 30,
+        "snes_max_it": args.max_iterations,
         "ksp_type": "preonly",
         "pc_type": "lu",
         "pc_factor_mat_solver_type": "mumps",
