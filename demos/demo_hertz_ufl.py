@@ -133,8 +133,13 @@ lmbda = E * nu / ((1 + nu) * (1 - 2 * nu))
 
 # %%
 here = Path(__file__).parent if "__file__" in globals() else Path.cwd()
-geo = next(p / "hertz_cylinder.geo" for p in (here.parent / "meshes", here / "meshes", here)
-           if (p / "hertz_cylinder.geo").exists())
+candidates = [folder / "hertz_cylinder.geo" for folder in (here.parent / "meshes", here / "meshes")]
+geo = next((path for path in candidates if path.exists()), None)
+if geo is None:
+    raise FileNotFoundError(
+        f"meshes/hertz_cylinder.geo not found (looked at {[str(p) for p in candidates]}); "
+        "run the demo from the repository's root or its demos/ folder."
+    )
 
 
 def mesh_geo(gmsh) -> None:
@@ -197,8 +202,10 @@ say(f"Displacement dofs: {n_u}, multiplier dofs: {n_lam}")
 # psi = lmbda/2 (tr E)^2 + mu E:E with E = (F^T F - I)/2 (the paper's law),
 # or a compressible neo-Hookean law,
 # psi = mu/2 (I1 - 3) - mu ln J + lmbda/2 (ln J)^2 with I1 = tr(F^T F) + 1 in
-# plane strain and J = det F. The residual and the tangent are derived from
-# psi by UFL, so changing the law is changing this one function.
+# plane strain and J = det F. F is a `ufl.variable`, so the first
+# Piola-Kirchhoff stress would be `ufl.diff(psi, F)`; we never need it
+# explicitly: UFL derives the residual and the tangent from psi, so changing
+# the law means changing this one function.
 # In 2D the body is in plane strain (the out-of-plane stretch is one).
 
 # %%
