@@ -33,15 +33,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 from dolfinx.fem import petsc as fem_petsc
 
-from fenics_contact.model.problem import ContactProblem, ProblemState
+from fenics_contact.model.problem import ContactProblem, ProblemState, VariationalSystem
 from fenics_contact.model.scaling import residual_floor
-from fenics_contact.solvers.base import Observer, SolveResult, newton_loop, timed
+from fenics_contact.solvers.base import NewtonStrategy, Observer, SolveResult, newton_loop, timed
 from fenics_contact.solvers.diagnostics import ConvergenceMonitor, SolverSettings, Status
-from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.newton import NewtonKernel
 
 
@@ -77,7 +77,7 @@ class _Tally:
         self.switches = []
 
 
-class AutoStrategy:
+class AutoStrategy(NewtonStrategy):
     """GNRM at a well-scaled internal r, with line search and penalty warm start."""
 
     name = "auto"
@@ -87,17 +87,16 @@ class AutoStrategy:
         problem: ContactProblem,
         settings: SolverSettings,
         *,
-        linear: LinearSolverSettings | None = None,
-        observer: Observer | None = None,
         auto: AutoSettings | None = None,
+        **options: Any,
     ) -> None:
-        self.problem = problem
-        self.settings = settings
-        self.linear = linear or LinearSolverSettings()
-        self.observer = observer
+        super().__init__(problem, settings, **options)
         self.auto = auto or AutoSettings()
-        self.kernel = NewtonKernel(problem.augmented_system(), linear=self.linear)
         self._penalty: NewtonKernel | None = None
+
+    def build_system(self, problem: ContactProblem) -> VariationalSystem:
+        """The Alart-Curnier system, as for GNRM."""
+        return problem.augmented_system()
 
     # -- public ------------------------------------------------------------------
     def solve(self) -> SolveResult:

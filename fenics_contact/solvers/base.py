@@ -91,10 +91,24 @@ def timed(fn: Callable[[], SolveResult]) -> SolveResult:
     return result
 
 
-class MonolithicNewton:
-    """Plain Newton on one system built by :meth:`build_system` (GNRM and PM)."""
+class NewtonStrategy:
+    """A strategy configured once: problem, stopping rules, linear solver, observer.
+
+    Subclasses say which system their kernel solves (:meth:`build_system`);
+    plain Newton on it is :meth:`solve` (GNRM and PM). Strategies that update
+    the multiplier between steps override :meth:`residual_norm` and
+    :meth:`after_step` (SUA) or :meth:`solve` itself (NUA, auto).
+
+    Args:
+        problem: the problem solved; its current state is the start.
+        settings: stopping rules.
+        linear: linear solver of the Newton kernel (direct MUMPS when None).
+        observer: called with (iterations, residual) at every residual check.
+    """
 
     name = "newton"
+    #: True when each step is followed by a multiplier update (counted as updates).
+    updates_each_step = False
 
     def __init__(
         self,
@@ -106,21 +120,38 @@ class MonolithicNewton:
     ) -> None:
         self.problem = problem
         self.settings = settings
+        self.linear = linear or LinearSolverSettings()
         self.observer = observer
-        self.kernel = NewtonKernel(self.build_system(problem), linear=linear)
+        self.kernel = NewtonKernel(self.build_system(problem), linear=self.linear)
 
     def build_system(self, problem: ContactProblem) -> VariationalSystem:
-        """The residual blocks this strategy solves."""
+        """The residual blocks this strategy's kernel solves."""
         raise NotImplementedError
 
+    def monitor(self, settings: SolverSettings | None = None) -> ConvergenceMonitor:
+        """A fresh convergence monitor reporting to the observer."""
+        return ConvergenceMonitor(settings or self.settings, observer=self.observer)
+
+    def residual_norm(self) -> float:
+        """The norm the stopping test reads (default: the kernel's residual)."""
+        return self.kernel.assemble_residual()
+
+    def after_step(self) -> None:
+        """Runs after every Newton step (default: nothing)."""
+
     def solve(self) -> SolveResult:
-        """Newton until the system's residual norm passes the stopping test."""
+        """Newton until the residual norm passes the stopping test."""
         return timed(self._solve)
 
     def _solve(self) -> SolveResult:
-        monitor = ConvergenceMonitor(self.settings, observer=self.observer)
+        monitor = self.monitor()
         before = self.kernel.linear_solves
         status, steps = newton_loop(
-            self.kernel, monitor, self.kernel.assemble_residual, self.problem.active_signature
+            self.kernel, monitor, self.residual_norm, self.problem.active_signature,
+            after_step=self.after_step,
         )
-        return SolveResult(status, steps, 0, self.kernel.linear_solves - before, monitor.residuals)
+        updates = steps if self.updates_each_step else 0
+        return SolveResult(
+            status, steps, updates, self.kernel.linear_solves - before, monitor.residuals
+        )
+

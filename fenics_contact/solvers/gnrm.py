@@ -8,10 +8,10 @@ The residual measure is the norm of (equilibrium, complementarity).
 from __future__ import annotations
 
 from fenics_contact.model.problem import ContactProblem, VariationalSystem
-from fenics_contact.solvers.base import MonolithicNewton
+from fenics_contact.solvers.base import NewtonStrategy
 
 
-class GeneralizedNewton(MonolithicNewton):
+class GeneralizedNewton(NewtonStrategy):
     """Newton on (u, lam) of the augmented Lagrangian (paper's GNRM)."""
 
     name = "gnrm"

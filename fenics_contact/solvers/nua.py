@@ -10,11 +10,11 @@ runs to the outer tolerance.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 from fenics_contact.model.problem import ContactProblem
-from fenics_contact.solvers.base import Observer, SolveResult, timed
-from fenics_contact.solvers.diagnostics import ConvergenceMonitor, SolverSettings, Status
-from fenics_contact.solvers.linear import LinearSolverSettings
+from fenics_contact.solvers.base import SolveResult, timed
+from fenics_contact.solvers.diagnostics import SolverSettings, Status
 from fenics_contact.solvers.uzawa import UzawaBase
 
 
@@ -35,11 +35,10 @@ class NestedUzawa(UzawaBase):
         problem: ContactProblem,
         settings: SolverSettings,
         *,
-        linear: LinearSolverSettings | None = None,
-        observer: Observer | None = None,
         nested: NestedSettings | None = None,
+        **options: Any,
     ) -> None:
-        super().__init__(problem, settings, linear=linear, observer=observer)
+        super().__init__(problem, settings, **options)
         self.nested = nested or NestedSettings()
 
     def solve(self) -> SolveResult:
@@ -47,7 +46,7 @@ class NestedUzawa(UzawaBase):
         return timed(self._solve)
 
     def _solve(self) -> SolveResult:
-        monitor = ConvergenceMonitor(self.settings, observer=self.observer)
+        monitor = self.monitor()
         before = self.kernel.linear_solves
         steps = updates = 0
         fresh = True  # a Newton step was taken since the last update

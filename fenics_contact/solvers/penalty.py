@@ -7,10 +7,10 @@ pressure / r.
 from __future__ import annotations
 
 from fenics_contact.model.problem import ContactProblem, VariationalSystem
-from fenics_contact.solvers.base import MonolithicNewton
+from fenics_contact.solvers.base import NewtonStrategy
 
 
-class Penalty(MonolithicNewton):
+class Penalty(NewtonStrategy):
     """Newton on Pi + r/2 int min(g, 0)^2; the multiplier stays zero."""
 
     name = "penalty"

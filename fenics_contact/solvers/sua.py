@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from fenics_contact.solvers.base import SolveResult, newton_loop, timed
-from fenics_contact.solvers.diagnostics import ConvergenceMonitor
 from fenics_contact.solvers.uzawa import UzawaBase
 
 
@@ -11,21 +9,8 @@ class SimultaneousUzawa(UzawaBase):
     """Newton in u with lam fixed; lam <- min(lam + r g, 0) after each iteration."""
 
     name = "sua"
+    updates_each_step = True
 
-    def solve(self) -> SolveResult:
-        """Iterate until the coupled residual passes the stopping test."""
-        return timed(self._solve)
-
-    def _solve(self) -> SolveResult:
-        monitor = ConvergenceMonitor(self.settings, observer=self.observer)
-        before = self.kernel.linear_solves
-        status, steps = newton_loop(
-            self.kernel,
-            monitor,
-            self.residual_norm,
-            self.problem.active_signature,
-            after_step=self.problem.update_multiplier,
-        )
-        return SolveResult(
-            status, steps, steps, self.kernel.linear_solves - before, monitor.residuals
-        )
+    def after_step(self) -> None:
+        """The Uzawa update (paper eq. 10)."""
+        self.problem.update_multiplier()

@@ -9,41 +9,34 @@ complementarity lam - min(lam + r g, 0)).
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from dolfinx import fem
 
 from mpi4py import MPI
 
 from fenics_contact.model.contact import assemble_local
-from fenics_contact.model.problem import ContactProblem
-from fenics_contact.solvers.base import Observer
+from fenics_contact.model.problem import ContactProblem, VariationalSystem
+from fenics_contact.solvers.base import NewtonStrategy
 from fenics_contact.solvers.diagnostics import SolverSettings
-from fenics_contact.solvers.linear import LinearSolverSettings
-from fenics_contact.solvers.newton import NewtonKernel
 
 
-class UzawaBase:
+class UzawaBase(NewtonStrategy):
     """Primal Newton kernel plus the complementarity residual."""
 
     name = "uzawa"
 
-    def __init__(
-        self,
-        problem: ContactProblem,
-        settings: SolverSettings,
-        *,
-        linear: LinearSolverSettings | None = None,
-        observer: Observer | None = None,
-    ) -> None:
-        self.problem = problem
-        self.settings = settings
-        self.observer = observer
-        self.kernel = NewtonKernel(problem.primal_system(), linear=linear)
+    def __init__(self, problem: ContactProblem, settings: SolverSettings, **options: Any) -> None:
+        super().__init__(problem, settings, **options)
         self._complementarity = fem.form(
             problem.complementarity_residual(), entity_maps=problem.surface.entity_maps
         )
         self.primal_norm = math.inf
         self.complementarity_norm = math.inf
+
+    def build_system(self, problem: ContactProblem) -> VariationalSystem:
+        """Equilibrium in u with lam held fixed."""
+        return problem.primal_system()
 
     def residual_norm(self) -> float:
         """Assemble both residuals; return the norm of the pair."""
