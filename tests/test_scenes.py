@@ -101,3 +101,31 @@ def test_shipped_scenes_are_valid():
         scene = load_scene(path)
         names.add(scene.name)
     assert {"paper-ex1", "paper-ex2", "hertz-cylinder", "block-3d"} <= names
+
+
+def test_geo_parameters_reach_the_mesh(tmp_path):
+    """[mesh] parameters override the .geo file's DefineConstant defaults."""
+    from fenics_contact.scene.build import build_mesh
+    from fenics_contact.scene.schema import load_scene
+
+    shipped = Path(__file__).parents[1] / "scenes" / "hertz_cylinder.toml"
+    text = shipped.read_text().replace('"../meshes/', f'"{shipped.parents[1]}/meshes/')
+    counts = {}
+    for h in (0.004, 0.008):
+        scene_file = tmp_path / f"h{h}.toml"
+        scene_file.write_text(text.replace("h_contact = 0.004", f"h_contact = {h}"))
+        domain = build_mesh(load_scene(scene_file)).domain
+        counts[h] = domain.comm.allreduce(domain.topology.index_map(0).size_local)
+    assert counts[0.008] < 0.6 * counts[0.004]
+
+
+def test_unknown_geo_parameter_is_named(tmp_path):
+    from fenics_contact.scene.build import build_mesh
+    from fenics_contact.scene.schema import SceneError, load_scene
+
+    shipped = Path(__file__).parents[1] / "scenes" / "hertz_cylinder.toml"
+    text = shipped.read_text().replace('"../meshes/', f'"{shipped.parents[1]}/meshes/')
+    scene_file = tmp_path / "bad.toml"
+    scene_file.write_text(text.replace("h_contact = 0.004", "h_contct = 0.004"))
+    with pytest.raises(SceneError, match=r"no parameter 'h_contct'.*h_contact"):
+        build_mesh(load_scene(scene_file))

@@ -10,12 +10,12 @@ def generate(geo: Path, out: Path, parameters: dict[str, float]) -> Path:
     """Mesh ``geo`` in its own dimension and write ``out`` (.msh, format 4.1)."""
     import gmsh
 
+    from fenics_contact.scene.meshing import open_geo
+
     gmsh.initialize()
     try:
         gmsh.option.setNumber("General.Terminal", 0)
-        for name, value in parameters.items():
-            gmsh.parser.setNumber(name, [value])
-        gmsh.open(str(geo))
+        open_geo(gmsh, geo, parameters)
         dim = max(d for d, _ in gmsh.model.getPhysicalGroups())
         gmsh.model.mesh.generate(dim)
         out.parent.mkdir(parents=True, exist_ok=True)

@@ -20,7 +20,7 @@ from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import material
 from fenics_contact.model.obstacles import RigidBall, RigidObstacle, RigidPlane
 from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement, SurfaceTraction
-from fenics_contact.scene.meshing import mesh_on_rank
+from fenics_contact.scene.meshing import mesh_on_rank, open_geo
 from fenics_contact.scene.schema import GENERATOR_TAGS, BoundarySpec, Scene, SceneError
 
 
@@ -65,26 +65,32 @@ def _generated(scene: Scene, comm: MPI.Comm) -> BodyMesh:
 def _open(gmsh: Any, scene: Scene) -> None:
     """Load the scene's .geo (parameters set) or .msh into the current gmsh session."""
     gmsh.option.setNumber("General.Terminal", 0)
-    for name, value in scene.mesh.parameters.items():
-        gmsh.parser.setNumber(name, [float(value)])
-    gmsh.open(str(scene.mesh.file))
+    try:
+        open_geo(gmsh, scene.mesh.file, scene.mesh.parameters)
+    except ValueError as exc:
+        raise SceneError(f"{scene.path.name}: [mesh] parameters: {exc}") from None
 
 
 def _physical_dimensions(scene: Scene, comm: MPI.Comm) -> set[int]:
     """Dimensions of the file's physical groups (read on rank 0, known to all)."""
     import gmsh
 
-    dims: set[int] = set()
+    found: set[int] | SceneError = set()
     if comm.rank == 0:
         started = not gmsh.isInitialized()
         if started:
             gmsh.initialize(interruptible=False)
         try:
             _open(gmsh, scene)
-            dims = {d for d, _ in gmsh.model.getPhysicalGroups()}
+            found = {d for d, _ in gmsh.model.getPhysicalGroups()}
+        except SceneError as exc:
+            found = exc  # told to every rank below, so that none waits forever
         finally:
             gmsh.finalize() if started else gmsh.model.remove()
-    return comm.bcast(dims, root=0)
+    found = comm.bcast(found, root=0)
+    if isinstance(found, SceneError):
+        raise found
+    return found
 
 
 def _from_gmsh(scene: Scene, comm: MPI.Comm) -> BodyMesh:

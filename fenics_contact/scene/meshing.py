@@ -8,6 +8,7 @@ The gmsh model is created on one MPI rank only and distributed by
 from __future__ import annotations
 
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from dolfinx.io.gmsh import MeshData, model_to_mesh
@@ -276,3 +277,29 @@ def mesh_on_rank(
                 gmsh.finalize()
             else:
                 gmsh.model.remove()
+
+
+def open_geo(gmsh: Any, path: Path | str, parameters: dict[str, float]) -> None:
+    """Open a gmsh .geo or .msh file in the current session with ``parameters`` set.
+
+    A .geo file declares its parameters with ``DefineConstant[x = {default,
+    Name "Parameters/x"}]``; such a declaration keeps the ONELAB value, so
+    each parameter is set both as a ONELAB number and as a parser variable
+    before the file is read. A name the file does not declare raises
+    ``ValueError`` listing the names it does.
+    """
+    if parameters and str(path).endswith(".geo"):
+        gmsh.open(str(path))  # a first read learns which parameters the file declares
+        declared = {n.split("/", 1)[1] for n in gmsh.onelab.getNames("Parameters/.*")}
+        gmsh.clear()
+        gmsh.onelab.clear()
+        unknown = sorted(set(parameters) - declared)
+        if unknown:
+            raise ValueError(
+                f"{Path(path).name} declares no parameter {', '.join(map(repr, unknown))}; "
+                f"it declares: {', '.join(sorted(declared)) or 'none'}."
+            )
+    for name, value in parameters.items():
+        gmsh.onelab.setNumber(f"Parameters/{name}", [float(value)])
+        gmsh.parser.setNumber(name, [float(value)])
+    gmsh.open(str(path))
