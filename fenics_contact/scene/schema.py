@@ -41,8 +41,10 @@ from pathlib import Path
 from typing import Any
 
 from fenics_contact.model.materials import MATERIALS
+from fenics_contact.solvers import STRATEGIES
 
-METHODS = ("penalty", "sua", "nua", "gnrm", "auto")
+#: Method names a scene may give: the strategy registry's.
+METHODS = tuple(STRATEGIES)
 #: Fields the XDMF output can hold.
 FIELDS = ("displacement", "contact_pressure", "gap", "active", "von_mises")
 GENERATOR_TAGS: dict[str, dict[str, int]] = {

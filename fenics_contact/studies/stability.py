@@ -31,13 +31,13 @@ from mpi4py import MPI
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.scaling import DEFAULT_FORCE_RTOL, scaled_atol
 from fenics_contact.output.io import write_json
-from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers import STRATEGIES, make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.stepping import RunRecord, StepRecord, solve_load_path, start_record
 from fenics_contact.verification.bench_scenes import BarScene, BlockScene, HertzScene
 
 #: Methods the stability grid runs by default.
-METHODS = ("penalty", "sua", "nua", "gnrm", "auto")
+METHODS = tuple(STRATEGIES)
 
 #: Extra statuses of a run besides the solver statuses.
 ERROR = "error"

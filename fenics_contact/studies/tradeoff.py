@@ -23,7 +23,7 @@ from mpi4py import MPI
 
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.scaling import DEFAULT_FORCE_RTOL, scaled_atol
-from fenics_contact.solvers import PAPER_NAMES, make_strategy
+from fenics_contact.solvers import PAPER_NAMES, STRATEGIES, make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings, Status
 from fenics_contact.solvers.stepping import RunRecord, solve_load_path, start_record
 from fenics_contact.studies.study import relative_l2_error
@@ -33,7 +33,7 @@ from fenics_contact.verification.bench_scenes import BarScene, HertzScene
 FULL_R = tuple(10.0**e for e in range(-4, 9))
 #: Displacement errors below this are round-off (relative L2); plots and fronts clip to it.
 ERROR_FLOOR = 1e-15
-METHODS = ("penalty", "sua", "nua", "gnrm", "auto")
+METHODS = tuple(STRATEGIES)
 
 
 def scene_meshes(name: str, count: int = 3) -> list[object]:
