@@ -27,10 +27,10 @@ def edited(old, new, text=EX2):
 MISTAKES = [
     ('law = "svk"', 'law = "svk"\nYoung = 3.0', r"unknown key 'Young'.*\[material\]"),
     ("r = 100.0", "rr = 100.0", r"unknown key 'rr'.*Did you mean 'r'\?"),
-    ("r = 100.0", "r = 0.0", r"\[contact\] r = 0.0: must be > 0"),
-    ("r = 100.0", "r = -5", r"\[contact\] r = -5: must be > 0"),
+    ("r = 100.0", "r = 0.0", r"\[contact\] r = 0.0: must be finite and > 0"),
+    ("r = 100.0", "r = -5", r"\[contact\] r = -5: must be finite and > 0"),
     ("nu = 0.3", "nu = 0.5", r"\[material\] nu = 0.5: must be < 0.5.*0.4999"),
-    ("E = 210.0", "E = -1.0", r"\[material\] E = -1.0: must be > 0"),
+    ("E = 210.0", "E = -1.0", r"\[material\] E = -1.0: must be finite and > 0"),
     ("dimension = 2", "dimension = 3", r"generator.*2D mesh but \[scene\] dimension = 3"),
     ("dimension = 2", "dimension = 4", r"dimension = 4: use 2 \(plane strain\) or 3"),
     ("value = [0.0, -0.8]", "value = [0.0, -0.8, 0.0]", r"value.*list of 2 numbers"),

@@ -54,6 +54,20 @@ def augmented_pressure(
     return ufl.min_value(lam + r * g, 0)
 
 
+def r_problem(r: float) -> str | None:
+    """What is wrong with the contact parameter r, or None: the one rule for r."""
+    if not (np.isfinite(r) and r > 0):
+        return "must be finite and > 0; typical values are 1e-2 to 1e2 relative to E/h."
+    return None
+
+
+def check_r(r: float) -> None:
+    """Raise ValueError when :func:`r_problem` finds r invalid."""
+    problem = r_problem(r)
+    if problem is not None:
+        raise ValueError(f"The contact parameter r = {r}: {problem}")
+
+
 @dataclass(frozen=True)
 class ContactSettings:
     """How contact is regularised and integrated.
@@ -73,11 +87,7 @@ class ContactSettings:
     quadrature: Quadrature = "nodal"
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.r) and self.r > 0):
-            raise ValueError(
-                f"The contact parameter r must be finite and > 0, got r = {self.r}; "
-                "typical values are 1 to 1e4 relative to E/h."
-            )
+        check_r(self.r)
         if self.quadrature not in ("nodal", "gauss"):
             raise ValueError(
                 f"Contact quadrature {self.quadrature!r} is unknown; use 'nodal' or 'gauss'."

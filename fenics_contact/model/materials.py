@@ -8,9 +8,37 @@ written by hand: the residual is ``ufl.derivative`` of the stored energy.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import ufl
+
+
+def elastic_constants_problem(E: float, nu: float) -> tuple[str, str] | None:
+    """Why (E, nu) are not valid isotropic constants: (name, what is wrong), or None.
+
+    The one definition of the rule; materials, scenes and the analytic
+    references all ask it.
+    """
+    if not (math.isfinite(E) and E > 0):
+        return "E", "must be finite and > 0."
+    if not nu < 0.5:
+        return "nu", (
+            "must be < 0.5 (exact incompressibility is not supported); use 0.4999 "
+            "for a near-incompressible body."
+        )
+    if not nu > -1.0:
+        return "nu", "must be > -1."
+    return None
+
+
+def check_elastic_constants(E: float, nu: float) -> None:
+    """Raise ValueError naming the bad constant, its value and the fix."""
+    problem = elastic_constants_problem(E, nu)
+    if problem is not None:
+        name, message = problem
+        value = E if name == "E" else nu
+        raise ValueError(f"{name} = {value}: {message}")
 
 
 @dataclass(frozen=True)
@@ -26,13 +54,7 @@ class Elastic:
     nu: float
 
     def __post_init__(self) -> None:
-        if not self.E > 0:
-            raise ValueError(f"Young's modulus E must be > 0, got E = {self.E}.")
-        if not -1.0 < self.nu < 0.5:
-            raise ValueError(
-                f"Poisson's ratio nu must lie in (-1, 0.5), got nu = {self.nu}; "
-                "use nu < 0.5 (for example 0.4999) for near-incompressibility."
-            )
+        check_elastic_constants(self.E, self.nu)
 
     @property
     def mu(self) -> float:

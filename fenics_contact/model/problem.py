@@ -25,6 +25,7 @@ from fenics_contact.model.contact import (
     ContactSurface,
     augmented_lagrangian_energy,
     augmented_pressure,
+    check_r,
     penalty_energy,
 )
 from fenics_contact.model.materials import Elastic
@@ -213,8 +214,7 @@ class ContactProblem:
 
     def set_r(self, r: float, *, relative: bool) -> None:
         """Set the penalty/augmentation parameter, relative to E/h or absolute."""
-        if not (np.isfinite(r) and r > 0):
-            raise ValueError(f"r must be finite and > 0, got {r}.")
+        check_r(r)
         self.r.value = r * self.stiffness_scale if relative else r
 
     @property

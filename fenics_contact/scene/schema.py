@@ -40,7 +40,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fenics_contact.model.materials import MATERIALS
+from fenics_contact.model.contact import r_problem
+from fenics_contact.model.materials import MATERIALS, elastic_constants_problem
 from fenics_contact.solvers import STRATEGIES
 
 #: Method names a scene may give: the strategy registry's.
@@ -366,10 +367,19 @@ def _contact(reader: _Reader) -> ContactSpec:
         tag=reader.tag("tag") if not detect else None,
         detect=detect,
         margin=reader.number("margin", 0.0) if detect else 0.0,
-        r=reader.number("r", 1.0, positive=True),
+        r=_contact_r(reader),
         relative=reader.flag("relative", True),
         quadrature=reader.choice("quadrature", ("nodal", "gauss"), default="nodal"),
     )
+
+
+def _contact_r(reader: _Reader) -> float:
+    """R, checked by the contact term's own rule."""
+    r = reader.number("r", 1.0)
+    problem = r_problem(r)
+    if problem is not None:
+        raise reader.fail("r", problem)
+    return r
 
 
 def _solver(reader: _Reader) -> SolverSpec:
@@ -409,6 +419,7 @@ def load_scene(path: Path | str) -> Scene:
         raise material.fail(
             "kinematics", f"does not match law = {law!r}; small strain is law = 'linear'."
         )
+    E, nu = _elastic_constants(material)
     output = _table(path, data, "output", required=False)
     fields = output.table.get("fields", list(FIELDS))
     if not isinstance(fields, list) or any(f not in FIELDS for f in fields):
@@ -420,8 +431,8 @@ def load_scene(path: Path | str) -> Scene:
         description=str(head.table.get("description", "")),
         mesh=_mesh(path, _table(path, data, "mesh"), dimension),
         law=law,
-        E=material.number("E", positive=True),
-        nu=_poisson(material),
+        E=E,
+        nu=nu,
         dirichlet=tuple(_boundary(r, dimension, True) for r in _array(path, data, "dirichlet")),
         tractions=tuple(_boundary(r, dimension, False) for r in _array(path, data, "traction")),
         obstacle=_obstacle(_table(path, data, "obstacle"), dimension),
@@ -432,13 +443,10 @@ def load_scene(path: Path | str) -> Scene:
     )
 
 
-def _poisson(material: _Reader) -> float:
-    nu = material.number("nu")
-    if nu >= 0.5:
-        raise material.fail(
-            "nu", "must be < 0.5 (exact incompressibility is not supported); use 0.4999 "
-            "for a near-incompressible body."
-        )
-    if nu <= -1.0:
-        raise material.fail("nu", "must be > -1.")
-    return nu
+def _elastic_constants(material: _Reader) -> tuple[float, float]:
+    """E and nu, checked by the materials' own rule."""
+    E, nu = material.number("E"), material.number("nu")
+    problem = elastic_constants_problem(E, nu)
+    if problem is not None:
+        raise material.fail(*problem)
+    return E, nu

@@ -23,13 +23,12 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from fenics_contact.model.materials import check_elastic_constants
+
 
 def plane_strain_modulus(E: float, nu: float) -> float:
     """E* = E / (1 - nu^2) of a body against a rigid one (stress units)."""
-    if not E > 0:
-        raise ValueError(f"Young's modulus must be > 0, got E = {E}.")
-    if not -1.0 < nu < 0.5:
-        raise ValueError(f"Poisson's ratio must lie in (-1, 0.5), got nu = {nu}.")
+    check_elastic_constants(E, nu)
     return E / (1.0 - nu**2)
 
 
