@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -53,6 +53,9 @@ class RunRecord:
     contact_force: float
     steps_completed: int
     residuals: list[list[float]] = field(default_factory=list)
+    #: The scalar the example reports through ``probe(problem)`` (Example 1: the
+    #: corner displacement u, length), NaN when it has none or the run failed.
+    probe: float = math.nan
 
     def row(self) -> dict[str, object]:
         """Flat row for CSV (no histories)."""
@@ -116,6 +119,8 @@ def run_one(
         if reference is not None and path.converged
         else math.nan
     )
+    probe = getattr(example, "probe", None)
+    value = float(probe(problem)) if probe is not None and path.converged else math.nan
     record = RunRecord(
         method=method,
         r=problem.r_absolute,
@@ -130,6 +135,7 @@ def run_one(
         contact_force=last.contact_force,
         steps_completed=done,
         residuals=[h for s in path.steps for h in s.residuals],
+        probe=value,
     )
     return record, problem, path
 
@@ -194,3 +200,53 @@ def paper_table(records: Sequence[RunRecord], limit: int = 500) -> str:
             ]
             lines.append("| | " + " | ".join(ups) + " |")
     return "\n".join(lines)
+
+
+#: A table source: study records, or a published table (method -> cells, and
+#: "nua updates" -> the second NUA row).
+Source = Sequence[RunRecord] | Mapping[str, Sequence[str]]
+
+
+def _cells(source: Source, method: str, rs: Sequence[float], limit: int) -> tuple[list, list]:
+    """Iteration cells and NUA update cells of one method from one source."""
+    if isinstance(source, Mapping):
+        return list(source.get(method, [])), list(source.get(f"{method} updates", []))
+    by_key = {(rec.method, rec.r): rec for rec in source}
+    recs = [by_key.get((method, r)) for r in rs]
+    its = [cell(rec, limit) if rec is not None else "" for rec in recs]
+    ups = [
+        f"{rec.updates} updates"
+        if rec is not None and rec.status == Status.CONVERGED.value
+        else ""
+        for rec in recs
+    ]
+    return its, ups
+
+
+def comparison_table(
+    sources: Sequence[tuple[str, Source]],
+    r_values: Sequence[float],
+    methods: Sequence[str],
+    limit: int = 500,
+) -> str:
+    """Markdown table with one row per method and source (ours, the paper, an analog...)."""
+    header = "| Method | source | " + " | ".join(f"r = {r:g}" for r in r_values) + " |"
+    lines = [header, "|---" * (len(r_values) + 2) + "|"]
+    for m in methods:
+        for label, source in sources:
+            its, ups = _cells(source, m, r_values, limit)
+            if not any(its):
+                continue
+            lines.append(f"| {PAPER_NAMES.get(m, m)} | {label} | " + " | ".join(its) + " |")
+            if m == "nua" and any(ups):
+                lines.append(f"| | {label} | " + " | ".join(ups) + " |")
+    return "\n".join(lines)
+
+
+def probe_line(records: Sequence[RunRecord], method: str = "penalty") -> str:
+    """The probed value of one method at every r, e.g. the penalty displacement."""
+    values = [(rec.r, rec.probe, rec.status) for rec in records if rec.method == method]
+    return ", ".join(
+        f"{v:.6g} (r = {r:g})" if math.isfinite(v) else f"{status} (r = {r:g})"
+        for r, v, status in values
+    )
