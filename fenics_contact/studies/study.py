@@ -202,15 +202,16 @@ def paper_table(records: Sequence[RunRecord], limit: int = 500) -> str:
     return "\n".join(lines)
 
 
-#: A table source: study records, or a published table (method -> cells, and
+#: A table source: study records, or a published table (method -> {r: cell}, and
 #: "nua updates" -> the second NUA row).
-Source = Sequence[RunRecord] | Mapping[str, Sequence[str]]
+Source = Sequence[RunRecord] | Mapping[str, Mapping[float, str]]
 
 
 def _cells(source: Source, method: str, rs: Sequence[float], limit: int) -> tuple[list, list]:
     """Iteration cells and NUA update cells of one method from one source."""
     if isinstance(source, Mapping):
-        return list(source.get(method, [])), list(source.get(f"{method} updates", []))
+        its, ups = source.get(method, {}), source.get(f"{method} updates", {})
+        return [its.get(r, "") for r in rs], [ups.get(r, "") for r in rs]
     by_key = {(rec.method, rec.r): rec for rec in source}
     recs = [by_key.get((method, r)) for r in rs]
     its = [cell(rec, limit) if rec is not None else "" for rec in recs]
