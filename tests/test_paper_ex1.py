@@ -73,8 +73,20 @@ def test_gnrm_finds_u_equal_2h_in_two_newton_steps(r):
     assert len(path.steps[0].residuals[0]) == 3
     assert EX1.corner_displacement(problem) == pytest.approx(2 * H, abs=1e-12)
     state = problem.contact_state()
-    assert abs(state.gap[0]) < 1e-12
-    assert state.pressure[0] == pytest.approx(-60.828932, abs=1e-5)
+    assert state.max_penetration < 1e-12
+    assert state.contact_force == pytest.approx(60.828932, abs=1e-5)
+
+
+@pytest.mark.mpi
+def test_gnrm_and_penalty_on_any_number_of_ranks():
+    """One cell: on two ranks one of them holds no contact element."""
+    path, problem = solve("gnrm", 100.0)
+    assert path.converged and path.iterations == 2
+    assert EX1.corner_displacement(problem) == pytest.approx(2 * H, abs=1e-12)
+    assert problem.contact_state().contact_force == pytest.approx(60.828932, abs=1e-5)
+    path, problem = solve("penalty", 100.0)
+    assert path.converged and path.iterations == 4
+    assert EX1.corner_displacement(problem) == pytest.approx(NUMPY_PENALTY_U[100.0], abs=1e-8)
 
 
 #: Penalty displacement with 2 x 2 Gauss energy, from the numpy model of
