@@ -22,10 +22,15 @@ This script searches a family of such elements in plain numpy (no FEniCS):
   Psi is a quartic polynomial in u, recovered exactly by a fit;
 - penalty equilibrium (paper eq. 7, one node): Psi'(u) + r min(g, 0) g'(u) = 0.
 
+It also runs the Uzawa schemes on the one-dof model of the chosen geometry
+with variants the paper leaves open (which gap the simultaneous update uses,
+whether the primal tangent keeps the facet-rotation term).
+
 Output: ``paper_ex1_geometry.json`` (every candidate's numbers) and
 ``paper_ex1_geometry.md`` (the best candidates and the chosen geometry).
 
-Run: ``python benchmarks/paper_ex1_geometry.py [--out results/paper-ex1-geometry]``.
+Run: ``python benchmarks/paper_ex1_geometry.py [--out results/paper-ex1-geometry]
+[--figure docs/images/paper_ex1_geometry.png [--figure-only]]``.
 """
 
 from __future__ import annotations
@@ -112,18 +117,21 @@ class OneDof:
         disp[2] = u * self.e
         return svk_energy(self.nodes, disp, self.c.gauss)
 
-    def gap(self, u: float) -> float:
-        """Normal gap of the striker to the current facet (>= 0 open)."""
+    def _gap(self, u: complex) -> complex:
         xa = self.a
         xb = self.b + u * self.e
         t = xb - xa
-        n = np.array([-t[1], t[0]]) / np.hypot(*t)
+        n = np.array([-t[1], t[0]]) / np.sqrt(t[0] * t[0] + t[1] * t[1])
         xs = self.a + self.xi * (self.b - self.a) + H_STRIKER * self.d
-        return float((xs - xa) @ n)
+        return (xs - xa) @ n
 
-    def dgap(self, u: float, eps: float = 1e-7) -> float:
-        """Derivative of the gap in u (central difference)."""
-        return (self.gap(u + eps) - self.gap(u - eps)) / (2 * eps)
+    def gap(self, u: float) -> float:
+        """Normal gap of the striker to the current facet (>= 0 open)."""
+        return float(np.real(self._gap(u)))
+
+    def dgap(self, u: float) -> float:
+        """Derivative of the gap in u (complex step: exact to rounding)."""
+        return float(np.imag(self._gap(u + 1e-30j)) / 1e-30)
 
     def penalty_u(self, r: float) -> float:
         """Root of Psi'(u) + r min(g, 0) g'(u) between 2h and 0 (bisection); NaN if none."""
@@ -229,11 +237,145 @@ def report(rows: list[dict], chosen: dict, n_total: int) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _curvature(model: OneDof, u: float, eps: float = 1e-6) -> float:
+    """Second derivative of the gap (central difference of the exact first derivative)."""
+    return (model.dgap(u + eps) - model.dgap(u - eps)) / (2 * eps)
+
+
+def uzawa_counts(
+    model: OneDof, r: float, *, nested: bool, before: bool = False, rotation: bool = True,
+    limit: int = 500,
+) -> str:
+    """Uzawa on the one-dof model: Newton steps (and updates), tolerance 1e-8, from (0, 0).
+
+    ``before``: the simultaneous update uses the gap before the Newton step
+    (both variables from the same state) instead of after it. ``rotation``:
+    keep the facet-rotation term min(lam + r g, 0) g'' in the primal tangent.
+    Nested: inner tolerance 1e-3, as :mod:`fenics_contact.solvers.nua`.
+    """
+    u = lam = 0.0
+    steps = updates = 0
+    fresh = True
+    first = None
+    while True:
+        p = min(lam + r * model.gap(u), 0.0)
+        r_u = float(model.force(u)) + p * model.dgap(u)
+        norm = float(np.hypot(r_u, p - lam))
+        first = norm if first is None else first
+        if norm <= 1e-8:
+            return f"{steps}" + (f" ({updates} updates)" if nested else "")
+        if not np.isfinite(norm) or norm > 1e6 * first:
+            return "divergence"
+        if steps >= limit:
+            return f"> {limit}"
+        if nested and abs(r_u) <= (1e-8 if abs(p - lam) <= 1e-8 else 1e-3) and fresh:
+            lam, updates, fresh = p, updates + 1, False
+            continue
+        active = lam + r * model.gap(u) < 0
+        tangent = float(model.psi.deriv(2)(u)) + active * (
+            r * model.dgap(u) ** 2 + (p * _curvature(model, u) if rotation else 0.0)
+        )
+        u_new = u - r_u / tangent
+        steps, fresh = steps + 1, True
+        if not nested:
+            gap = model.gap(u if before else u_new)
+            lam = min(lam + r * gap, 0.0)
+        u = u_new
+
+
+def uzawa_report(model: OneDof) -> str:
+    """Markdown table of Uzawa variants on the chosen geometry."""
+    rs = (1.0, 10.0, 100.0, 1000.0, 10000.0)
+    variants = {
+        "SUA, update with the gap after the step (ours)": {"nested": False},
+        "SUA, update with the gap before the step": {"nested": False, "before": True},
+        "SUA, tangent without the facet-rotation term": {"nested": False, "rotation": False},
+        "NUA (ours)": {"nested": True},
+        "NUA, tangent without the facet-rotation term": {"nested": True, "rotation": False},
+    }
+    lines = [
+        "Uzawa variants on the one-dof model (Newton steps; no cycling test here):",
+        "",
+        "| variant | " + " | ".join(f"r = {r:g}" for r in rs) + " |",
+        "|---" * (len(rs) + 1) + "|",
+    ]
+    for label, kw in variants.items():
+        cells = [uzawa_counts(model, r, **kw) for r in rs]
+        lines.append(f"| {label} | " + " | ".join(cells) + " |")
+    u = U_EXACT
+    p = -float(model.force(u)) / model.dgap(u)
+    k = float(model.psi.deriv(2)(u)) + p * _curvature(model, u)
+    rates = ", ".join(f"{k / (k + r * model.dgap(u) ** 2):.3f}" for r in rs)
+    lines += [
+        "",
+        f"At the solution: force lam = {p:.6f}, Psi''(2h) = {float(model.psi.deriv(2)(u)):.4f},",
+        f"g' = {model.dgap(u):.6f}, g'' = {_curvature(model, u):.6f}, "
+        f"K = Psi'' + lam g'' = {k:.4f};",
+        f"linear Uzawa rate K / (K + r g'^2) for r = 1 ... 10000: {rates}.",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def figure(path: Path) -> None:
+    """Sketch of the reconstructed element and penalty u against r (ours and the paper's)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    model = OneDof(Candidate(1.0, 1.0, 0.0, 90.0, 90.0, 2))
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(10, 4.8), width_ratios=[1, 1.25])
+    square = np.array([[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]], float)
+    ax.plot(square[:, 0], square[:, 1], "k-", lw=2, label="reference element")
+    final = square.copy()
+    final[2, 1] += U_EXACT
+    ax.plot(final[:, 0], final[:, 1], "C0--", lw=1.5, label="exact state, u = 2h = -0.5")
+    ax.plot([0, 1], [1, 1 + U_EXACT], "C0-", lw=3, alpha=0.5)
+    ax.plot([0.5], [1.0], "o", color="C3", ms=9, mfc="none")
+    ax.plot([0.5], [1.0 + H_STRIKER], "o", color="C3", ms=9, label="striker node, h = -0.25")
+    ax.annotate("", xy=(0.5, 1.0 + H_STRIKER), xytext=(0.5, 1.25),
+                arrowprops={"arrowstyle": "->", "color": "C3"})
+    ax.annotate("", xy=(1.0, 1.0 + U_EXACT), xytext=(1.0, 1.0),
+                arrowprops={"arrowstyle": "->", "color": "C0"})
+    ax.text(1.04, 0.72, "u", color="C0", fontsize=12)
+    ax.text(-0.1, 1.06, "a", fontsize=11)
+    ax.text(1.04, 1.06, "b", fontsize=11)
+    for x, y in ((0, 0.5), (0.5, 0), (0, 0), (0, 1), (1, 0)):
+        ax.plot([x], [y], "ks", ms=6)
+    ax.plot([1.0], [0.5], "k>", ms=7)
+    ax.text(0.05, 0.35, "left and bottom faces clamped,\nright face slides vertically;\n"
+            "one unknown: u at b", fontsize=8)
+    ax.set_aspect("equal")
+    ax.set_xlim(-0.2, 1.35)
+    ax.set_ylim(-0.05, 1.35)
+    ax.set_title("Example 1 (reconstructed): SVK, E = 210, nu = 0.3")
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.08), ncol=2, fontsize=7)
+    rs = np.logspace(0, 4, 41)
+    bx.semilogx(rs, [model.penalty_u(r) for r in rs], "C0-",
+                label="penalty equilibrium u, this geometry")
+    bx.semilogx(list(PAPER), list(PAPER.values()), "C3o", ms=8, mfc="none",
+                label="paper, Table 1 text")
+    bx.axhline(U_EXACT, color="k", lw=0.8, ls=":", label="exact u = 2h")
+    bx.set_xlabel("r (absolute)")
+    bx.set_ylabel("corner displacement u")
+    bx.legend(fontsize=8)
+    bx.set_title("Penalty displacement against r")
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+
+
 def main() -> int:
     """Search the family and write JSON and markdown."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path("results/paper-ex1-geometry"))
+    parser.add_argument("--figure", type=Path, help="also draw the sketch to this PNG")
+    parser.add_argument("--figure-only", action="store_true", help="skip the search")
     args = parser.parse_args()
+    if args.figure is not None:
+        figure(args.figure)
+        if args.figure_only:
+            return 0
     candidates = family()
     rows = [row for c in candidates if (row := evaluate(c)) is not None]
     chosen = evaluate(Candidate(1.0, 1.0, 0.0, 90.0, 90.0, 2))
@@ -242,7 +384,9 @@ def main() -> int:
     (args.out / "paper_ex1_geometry.json").write_text(
         json.dumps({"paper": PAPER, "chosen": chosen, "candidates": rows}, indent=1)
     )
-    text = report(rows, chosen, len(candidates))
+    text = report(rows, chosen, len(candidates)) + "\n" + uzawa_report(
+        OneDof(Candidate(1.0, 1.0, 0.0, 90.0, 90.0, 2))
+    )
     (args.out / "paper_ex1_geometry.md").write_text(text)
     print(text)
     return 0
