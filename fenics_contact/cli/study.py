@@ -60,7 +60,7 @@ def _study(args: argparse.Namespace) -> int:
     print()
     print(table)
     sources: list = [(args.example, records)]
-    published = getattr(example, "paper_table", None)
+    published = getattr(example, "published_table", None)
     if published is not None:
         sources.append(("paper", published))
     for other in args.beside:
