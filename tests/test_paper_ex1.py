@@ -147,6 +147,27 @@ def test_gnrm_diverges_above_the_critical_r():
     assert solve("gnrm", 1.02 * r_star)[0].status == Status.DIVERGED
 
 
+def test_bad_target_or_striker_is_refused_before_any_work():
+    from dolfinx import mesh
+
+    from mpi4py import MPI
+
+    from fenics_contact.model.materials import SaintVenantKirchhoff
+    from fenics_contact.verification.striker import StrikerOnFacetProblem
+
+    domain = mesh.create_unit_square(MPI.COMM_WORLD, 1, 1, mesh.CellType.quadrilateral)
+    top = mesh.locate_entities_boundary(domain, 1, lambda x: np.isclose(x[1], 1.0))
+    both = mesh.locate_entities_boundary(
+        domain, 1, lambda x: np.isclose(x[0], 1.0) | np.isclose(x[1], 1.0)
+    )
+    law = SaintVenantKirchhoff(PAPER_E, PAPER_NU)
+    settings = ContactSettings(r=1.0, relative=False)
+    with pytest.raises(ValueError, match="exactly one facet"):
+        StrikerOnFacetProblem(domain, law, both, (0.5, 1.0), (0.0, H), settings)
+    with pytest.raises(ValueError, match="striker_motion"):
+        StrikerOnFacetProblem(domain, law, top, (0.5, 1.0), (0.0, H, 0.0), settings)
+
+
 def test_the_wedge_analog_keeps_its_name():
     assert EXAMPLES["paper-ex1"] is StrikerOnFacet
     assert EXAMPLES["paper-ex1-wedge"] is WedgeOnCorner

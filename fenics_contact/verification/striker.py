@@ -81,6 +81,12 @@ def _oriented_vertices(domain: mesh.Mesh, facet: np.ndarray) -> tuple[np.ndarray
     The facet may live on one rank only; every rank gets the coordinates.
     """
     tdim = domain.topology.dim
+    n_global = domain.comm.allreduce(int(facet.size))
+    if n_global != 1:
+        raise ValueError(
+            f"The target must be exactly one facet of the mesh, got {n_global}; "
+            "pass the index of one boundary facet (an empty array on the other ranks)."
+        )
     domain.topology.create_connectivity(tdim - 1, tdim)
     domain.topology.create_connectivity(tdim - 1, 0)
     found = None
@@ -94,13 +100,7 @@ def _oriented_vertices(domain: mesh.Mesh, facet: np.ndarray) -> tuple[np.ndarray
         if np.dot(np.array([-t[1], t[0]]), 0.5 * (a + b) - centre) < 0:
             a, b = b, a
         found = (a.copy(), b.copy())
-    gathered = [v for v in domain.comm.allgather(found) if v is not None]
-    if len(gathered) != 1:
-        raise ValueError(
-            f"The target must be exactly one facet of the mesh, found {len(gathered)}; "
-            "pass the index of one boundary facet."
-        )
-    return gathered[0]
+    return next(v for v in domain.comm.allgather(found) if v is not None)
 
 
 class StrikerOnFacetProblem:
@@ -140,6 +140,14 @@ class StrikerOnFacetProblem:
     ) -> None:
         if domain.topology.dim != 2 or domain.geometry.dim != 2:
             raise ValueError("The node-to-segment striker problem is 2D; give a 2D mesh.")
+        if domain.geometry.cmaps[0].degree != 1:
+            raise ValueError(
+                f"The target facet must be straight, but the mesh geometry has degree "
+                f"{domain.geometry.cmaps[0].degree}; use an affine (degree 1) mesh."
+            )
+        for name, value in (("striker_start", striker_start), ("striker_motion", striker_motion)):
+            if len(value) != 2:
+                raise ValueError(f"{name} = {tuple(value)} needs two coordinates (x, y).")
         self.domain = domain
         self.comm = domain.comm
         self.material = material
