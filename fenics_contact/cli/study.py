@@ -73,6 +73,7 @@ def _study(args: argparse.Namespace) -> int:
         table = comparison_table(sources, args.r, args.methods, limit=args.max_iterations)
         print(f"\n{args.example} beside {', '.join(label for label, _ in sources[1:])}:\n")
         print(table)
+        print()
     for label, source in sources:
         if not isinstance(source, dict) and "penalty" in args.methods:
             if any(math.isfinite(rec.probe) for rec in source):
