@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 
@@ -36,7 +37,7 @@ def _study(args: argparse.Namespace) -> int:
     from fenics_contact.output.io import write_csv, write_json
     from fenics_contact.output.plotting import iterations_against_r, residual_histories
     from fenics_contact.solvers.diagnostics import SolverSettings
-    from fenics_contact.studies.study import paper_table, run_study
+    from fenics_contact.studies.study import comparison_table, paper_table, probe_line, run_study
     from fenics_contact.verification.examples import EXAMPLES
 
     example = EXAMPLES[args.example]()
@@ -58,6 +59,25 @@ def _study(args: argparse.Namespace) -> int:
     table = paper_table(records, limit=args.max_iterations)
     print()
     print(table)
+    sources: list = [(args.example, records)]
+    published = getattr(example, "published_table", None)
+    if published is not None:
+        sources.append(("paper", published))
+    for other in args.beside:
+        print(f"\nStudy {other} (beside {args.example})", flush=True)
+        sources.append((other, run_study(
+            EXAMPLES[other](), args.methods, args.r, relative=args.relative,
+            settings=settings, quadrature=args.quadrature, progress=show,
+        )))
+    if len(sources) > 1:
+        table = comparison_table(sources, args.r, args.methods, limit=args.max_iterations)
+        print(f"\n{args.example} beside {', '.join(label for label, _ in sources[1:])}:\n")
+        print(table)
+        print()
+    for label, source in sources:
+        if not isinstance(source, dict) and "penalty" in args.methods:
+            if any(math.isfinite(rec.probe) for rec in source):
+                print(f"Penalty probe ({label}): {probe_line(source)}")
     write_json(out / "study.json", [r.to_dict() for r in records])
     write_csv(out / "study.csv", [r.row() for r in records])
     (out / "table.md").write_text(table + "\n")
@@ -93,6 +113,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     study.add_argument(
         "--quadrature", choices=["nodal", "gauss"], default="nodal",
         help="contact integration: nodal (vertex rule, node-on-facet) or gauss",
+    )
+    study.add_argument(
+        "--beside", type=str, action="append", default=[], choices=sorted(EXAMPLES),
+        metavar="EXAMPLE",
+        help="also run EXAMPLE with the same settings and print its rows beside "
+        "(repeatable; e.g. --beside paper-ex1-wedge)",
     )
     study.add_argument("--tol", type=float, default=1e-8, help="residual tolerance (1e-8)")
     study.add_argument(

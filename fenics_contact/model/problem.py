@@ -141,7 +141,78 @@ class ContactState:
     contact_force: float
 
 
-class ContactProblem:
+class ProblemBase:
+    """What every contact problem shares: r, Dirichlet conditions, snapshots.
+
+    A subclass sets ``domain``, ``V``, ``u``, ``lam``, ``r`` (a Constant),
+    ``load_factor`` and ``stiffness_scale``, and defines ``set_load``.
+    """
+
+    domain: mesh.Mesh
+    V: fem.FunctionSpace
+    u: fem.Function
+    lam: fem.Function
+    r: fem.Constant
+    load_factor: float
+    _bc_constants: list[tuple[fem.Constant, float]]
+
+    @property
+    def stiffness_scale(self) -> float:
+        """The scale that makes r dimensionless (stress per length)."""
+        raise NotImplementedError
+
+    def set_load(self, t: float) -> None:
+        """Apply the load factor t."""
+        raise NotImplementedError
+
+    def set_r(self, r: float, *, relative: bool) -> None:
+        """Set the penalty/augmentation parameter, relative to E/h or absolute."""
+        check_r(r)
+        self.r.value = r * self.stiffness_scale if relative else r
+
+    @property
+    def r_absolute(self) -> float:
+        """R in stress per length."""
+        return float(self.r.value)
+
+    @property
+    def r_relative(self) -> float:
+        """R divided by E/h."""
+        return self.r_absolute / self.stiffness_scale
+
+    def _dirichlet(self, prescribed: Sequence[PrescribedDisplacement]) -> list[fem.DirichletBC]:
+        fdim = self.domain.topology.dim - 1
+        bcs = []
+        for condition in prescribed:
+            if len(condition.value) != self.domain.geometry.dim:
+                raise ValueError(
+                    f"Prescribed displacement {condition.value} needs one entry per "
+                    f"component ({self.domain.geometry.dim}); use None for a free one."
+                )
+            for i, value in enumerate(condition.value):
+                if value is None:
+                    continue
+                Vi = self.V.sub(i)
+                dofs = fem.locate_dofs_topological(Vi, fdim, condition.facets)
+                const = fem.Constant(self.domain, default_scalar_type(0.0))
+                self._bc_constants.append((const, float(value)))
+                bcs.append(fem.dirichletbc(const, dofs, Vi))
+        return bcs
+
+    def snapshot(self) -> ProblemState:
+        """Copy the unknowns and the load factor (see :meth:`restore`)."""
+        return ProblemState(self.u.x.array.copy(), self.lam.x.array.copy(), self.load_factor)
+
+    def restore(self, state: ProblemState, *, load: bool = True) -> None:
+        """Put back a :meth:`snapshot`; ``load=False`` keeps the current load factor."""
+        self.u.x.array[:] = state.u
+        self.lam.x.array[:] = state.lam
+        if load:
+            self.set_load(state.load_factor)
+
+
+
+class ContactProblem(ProblemBase):
     """One deformable body, one rigid obstacle, proportional loading."""
 
     def __init__(
@@ -212,21 +283,6 @@ class ContactProblem:
         """E/h: the scale that makes r dimensionless (stress per length)."""
         return self.material.E / self.surface.h
 
-    def set_r(self, r: float, *, relative: bool) -> None:
-        """Set the penalty/augmentation parameter, relative to E/h or absolute."""
-        check_r(r)
-        self.r.value = r * self.stiffness_scale if relative else r
-
-    @property
-    def r_absolute(self) -> float:
-        """R in stress per length."""
-        return float(self.r.value)
-
-    @property
-    def r_relative(self) -> float:
-        """R divided by E/h."""
-        return self.r_absolute / self.stiffness_scale
-
     def set_load(self, t: float) -> None:
         """Apply the load factor t: prescribed values, tractions and obstacle motion."""
         self.load_factor = float(t)
@@ -235,25 +291,6 @@ class ContactProblem:
         for const, value in self._traction_constants:
             const.value[:] = t * value
         self.obstacle.translate_to(t * self._motion)
-
-    def _dirichlet(self, prescribed: Sequence[PrescribedDisplacement]) -> list[fem.DirichletBC]:
-        fdim = self.domain.topology.dim - 1
-        bcs = []
-        for condition in prescribed:
-            if len(condition.value) != self.domain.geometry.dim:
-                raise ValueError(
-                    f"Prescribed displacement {condition.value} needs one entry per "
-                    f"component ({self.domain.geometry.dim}); use None for a free one."
-                )
-            for i, value in enumerate(condition.value):
-                if value is None:
-                    continue
-                Vi = self.V.sub(i)
-                dofs = fem.locate_dofs_topological(Vi, fdim, condition.facets)
-                const = fem.Constant(self.domain, default_scalar_type(0.0))
-                self._bc_constants.append((const, float(value)))
-                bcs.append(fem.dirichletbc(const, dofs, Vi))
-        return bcs
 
     def _external_work(self, tractions: Sequence[SurfaceTraction]) -> ufl.Form | None:
         if not tractions:
@@ -269,17 +306,6 @@ class ContactProblem:
             self._traction_constants.append((const, np.asarray(traction.value, float)))
             work += ufl.dot(const, self.u) * ds(TRACTION_TAG0 + i)
         return work
-
-    def snapshot(self) -> ProblemState:
-        """Copy the unknowns and the load factor (see :meth:`restore`)."""
-        return ProblemState(self.u.x.array.copy(), self.lam.x.array.copy(), self.load_factor)
-
-    def restore(self, state: ProblemState, *, load: bool = True) -> None:
-        """Put back a :meth:`snapshot`; ``load=False`` keeps the current load factor."""
-        self.u.x.array[:] = state.u
-        self.lam.x.array[:] = state.lam
-        if load:
-            self.set_load(state.load_factor)
 
     # -- systems handed to solvers -------------------------------------------
     def augmented_system(self) -> VariationalSystem:

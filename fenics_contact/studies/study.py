@@ -9,7 +9,8 @@ penetration and the displacement error against a tight GNRM reference.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 import ufl
@@ -21,7 +22,7 @@ from fenics_contact.model.contact import ContactSettings, Quadrature
 from fenics_contact.model.problem import ContactProblem
 from fenics_contact.solvers import PAPER_NAMES, make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings, Status
-from fenics_contact.solvers.stepping import RunRecord, solve_load_path
+from fenics_contact.solvers.stepping import RunRecord, solve_load_path, start_record
 
 
 class Example:
@@ -32,6 +33,18 @@ class Example:
     def build(self, settings: ContactSettings, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProblem:
         """Create the problem."""
         raise NotImplementedError
+
+
+@dataclass
+class StudyRecord(RunRecord):
+    """One (method, r) run of a study: the run record plus the example's probe.
+
+    ``probe``: the scalar the example reports through ``probe(problem)``
+    (Example 1: the corner displacement u, length); NaN when it has none or
+    the run failed.
+    """
+
+    probe: float = math.nan
 
 
 def relative_l2_error(u: fem.Function, reference: np.ndarray) -> float:
@@ -75,13 +88,17 @@ def run_one(
     reference: np.ndarray | None = None,
     max_cutbacks: int = 0,
     comm: MPI.Comm = MPI.COMM_WORLD,
-) -> tuple[RunRecord, ContactProblem]:
+) -> tuple[StudyRecord, ContactProblem]:
     """Solve the example once with one method and one r."""
     problem = example.build(ContactSettings(r=r, relative=relative, quadrature=quadrature), comm)
     strategy = make_strategy(method, problem, settings)
-    record = solve_load_path(strategy, example.steps, max_cutbacks=max_cutbacks)
+    record = StudyRecord(**vars(start_record(strategy)))
+    solve_load_path(strategy, example.steps, max_cutbacks=max_cutbacks, record=record)
     if reference is not None and record.converged:
         record.error = relative_l2_error(problem.u, reference)
+    probe = getattr(example, "probe", None)
+    if probe is not None and record.converged:
+        record.probe = float(probe(problem))
     return record, problem
 
 
@@ -145,3 +162,54 @@ def paper_table(records: Sequence[RunRecord], limit: int = 500) -> str:
             ]
             lines.append("| | " + " | ".join(ups) + " |")
     return "\n".join(lines)
+
+
+#: A table source: study records, or a published table (method -> {r: cell}, and
+#: "nua updates" -> the second NUA row).
+Source = Sequence[RunRecord] | Mapping[str, Mapping[float, str]]
+
+
+def _cells(source: Source, method: str, rs: Sequence[float], limit: int) -> tuple[list, list]:
+    """Iteration cells and NUA update cells of one method from one source."""
+    if isinstance(source, Mapping):
+        its, ups = source.get(method, {}), source.get(f"{method} updates", {})
+        return [its.get(r, "") for r in rs], [ups.get(r, "") for r in rs]
+    by_key = {(rec.method, rec.r): rec for rec in source}
+    recs = [by_key.get((method, r)) for r in rs]
+    its = [cell(rec, limit) if rec is not None else "" for rec in recs]
+    ups = [
+        f"{rec.updates} updates"
+        if rec is not None and rec.status == Status.CONVERGED.value
+        else ""
+        for rec in recs
+    ]
+    return its, ups
+
+
+def comparison_table(
+    sources: Sequence[tuple[str, Source]],
+    r_values: Sequence[float],
+    methods: Sequence[str],
+    limit: int = 500,
+) -> str:
+    """Markdown table with one row per method and source (ours, the paper, an analog...)."""
+    header = "| Method | source | " + " | ".join(f"r = {r:g}" for r in r_values) + " |"
+    lines = [header, "|---" * (len(r_values) + 2) + "|"]
+    for m in methods:
+        for label, source in sources:
+            its, ups = _cells(source, m, r_values, limit)
+            if not any(its):
+                continue
+            lines.append(f"| {PAPER_NAMES.get(m, m)} | {label} | " + " | ".join(its) + " |")
+            if m == "nua" and any(ups):
+                lines.append(f"| | {label} | " + " | ".join(ups) + " |")
+    return "\n".join(lines)
+
+
+def probe_line(records: Sequence[StudyRecord], method: str = "penalty") -> str:
+    """The probed value of one method at every r, e.g. the penalty displacement."""
+    values = [(rec.r, rec.probe, rec.status) for rec in records if rec.method == method]
+    return ", ".join(
+        f"{v:.6g} (r = {r:g})" if math.isfinite(v) else f"{status} (r = {r:g})"
+        for r, v, status in values
+    )

@@ -19,10 +19,7 @@ from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import material
 from fenics_contact.model.obstacles import RigidBall
 from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
-
-#: The paper's material for both examples (stress units).
-PAPER_E = 210.0
-PAPER_NU = 0.3
+from fenics_contact.verification.paper import PAPER_E, PAPER_NU, PAPER_TABLE_2
 
 
 @dataclass(frozen=True)
@@ -65,6 +62,9 @@ class BarOnCradle:
     length: float = 6.0
     height: float = 1.0
     radius: float = 10.0
+
+    #: The paper's Table 2, for the study's side-by-side print.
+    published_table = PAPER_TABLE_2
 
     @property
     def label(self) -> str:

@@ -35,8 +35,9 @@ from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import material
 from fenics_contact.model.obstacles import RigidPlane
 from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
-from fenics_contact.verification.bar import PAPER_E, PAPER_NU, BarOnCradle
+from fenics_contact.verification.bar import BarOnCradle
 from fenics_contact.verification.hertz_problem import HertzCylinder
+from fenics_contact.verification.paper import PAPER_E, PAPER_NU
 
 #: The Example 2 bar with every knob a sweep turns.
 BarScene = BarOnCradle

@@ -1,7 +1,10 @@
-"""The paper's examples (analogs) that the ``study`` command knows.
+"""The paper's examples (and the wedge analog) that the ``study`` command knows.
 
-The paper's Figures 1 and 2 are not available; the geometry of each analog
-is chosen here and documented in its docstring.
+The paper's Figures 1 and 2 are not available. Example 1's geometry is
+reconstructed from the paper's own numbers (:class:`StrikerOnFacet`, see
+``benchmarks/paper_ex1_geometry.py`` and ``docs/paper_ex1.md``); the earlier
+rigid-wedge analog stays as :class:`WedgeOnCorner`. Example 2 is an analog
+whose geometry is chosen here and documented in its docstring.
 """
 
 from __future__ import annotations
@@ -9,7 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from dolfinx import mesh
+from dolfinx import fem, mesh
 
 from mpi4py import MPI
 
@@ -17,12 +20,120 @@ from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import SaintVenantKirchhoff
 from fenics_contact.model.obstacles import RigidPlane
 from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
-from fenics_contact.verification.bar import PAPER_E, PAPER_NU, BarOnCradle
+from fenics_contact.verification.bar import BarOnCradle
+from fenics_contact.verification.paper import PAPER_E, PAPER_NU, PAPER_TABLE_1
+from fenics_contact.verification.striker import StrikerOnFacetProblem
+
+
+def _one_free_corner(domain: mesh.Mesh) -> list[PrescribedDisplacement]:
+    """Unit square clamped on its left and bottom faces, right face vertical only.
+
+    Leaves one free unknown: the vertical displacement of the corner (1, 1).
+    """
+    fdim = domain.topology.dim - 1
+
+    def side(axis: int, value: float) -> np.ndarray:
+        return mesh.locate_entities_boundary(domain, fdim, lambda x: np.isclose(x[axis], value))
+
+    return [
+        PrescribedDisplacement(side(0, 0.0), (0.0, 0.0)),
+        PrescribedDisplacement(side(1, 0.0), (0.0, 0.0)),
+        PrescribedDisplacement(side(0, 1.0), (0.0, None)),
+    ]
+
+
+def _corner_displacement(V: fem.FunctionSpace, u: fem.Function) -> float:
+    """Vertical displacement of the corner (1, 1), gathered from the rank that owns it."""
+    coords = V.tabulate_dof_coordinates()
+    corner = np.flatnonzero(np.isclose(coords[:, 0], 1.0) & np.isclose(coords[:, 1], 1.0))
+    values = u.x.array.reshape(-1, 2)[corner, 1]
+    found = V.mesh.comm.allgather(values.tolist())
+    return float(next(v for vs in found for v in vs))
+
+
+def _corner_dofs(V: fem.FunctionSpace, value: float) -> np.ndarray:
+    """Dof values of a displacement that moves only the corner (1, 1), vertically by value."""
+    coords = V.tabulate_dof_coordinates()
+    exact = np.zeros((coords.shape[0], 2))
+    exact[np.isclose(coords[:, 0], 1.0) & np.isclose(coords[:, 1], 1.0), 1] = value
+    return exact.ravel()
+
+
+@dataclass(frozen=True)
+class StrikerOnFacet:
+    """The paper's Example 1: a striker node pushes the top facet of one SVK quadrilateral.
+
+    Reconstructed geometry (the paper's Figure 1 is not available; see
+    ``benchmarks/paper_ex1_geometry.py``): the unit square [0, 1]^2 in plane
+    strain, clamped on its left and bottom faces, its right face free to
+    move vertically only, so the one unknown is the vertical displacement
+    u of the corner b = (1, 1). The target facet is the top face a -> b,
+    a = (0, 1) fixed. The striker node starts on the facet at its midpoint
+    (0.5, 1) and moves straight down by h = -0.25. The node-to-segment gap is
+
+        g(u) = (h - u/2) / sqrt(1 + u^2),
+
+    nonlinear in u through the rotation of the facet about a. The striker
+    stops the facet's midpoint at 1 + h, so the corner stops at
+
+        u = 2 h = -0.5,
+
+    from geometry alone, as the paper says. With the strain energy
+    integrated by 2 x 2 Gauss points, the penalty method gives u = -0.098750
+    at r = 100 and -0.38727 at r = 1000: the paper's -0.0988 and -0.387 to
+    every printed digit. Units: E = 210 (stress), lengths as given; r is a
+    point stiffness (force per length, per unit thickness), absolute as in
+    the paper.
+    """
+
+    h: float = -0.25
+    striker_at: float = 0.5
+    steps: int = 1
+    energy_quadrature_degree: int = 2
+
+    @property
+    def exact_u(self) -> float:
+        """The exact corner displacement h / striker_at (2 h at the midpoint)."""
+        return self.h / self.striker_at
+
+    #: Paper's Table 1, for the study's side-by-side print.
+    published_table = PAPER_TABLE_1
+
+    def build(
+        self,
+        settings: ContactSettings,
+        comm: MPI.Comm = MPI.COMM_WORLD,
+    ) -> StrikerOnFacetProblem:
+        """Create the one-element mesh and the node-to-segment problem."""
+        domain = mesh.create_unit_square(comm, 1, 1, mesh.CellType.quadrilateral)
+        top = mesh.locate_entities_boundary(domain, 1, lambda x: np.isclose(x[1], 1.0))
+        return StrikerOnFacetProblem(
+            domain,
+            SaintVenantKirchhoff(E=PAPER_E, nu=PAPER_NU),
+            top,
+            striker_start=(self.striker_at, 1.0),
+            striker_motion=(0.0, self.h),
+            settings=settings,
+            prescribed=_one_free_corner(domain),
+            energy_quadrature_degree=self.energy_quadrature_degree,
+        )
+
+    def corner_displacement(self, problem: StrikerOnFacetProblem) -> float:
+        """Vertical displacement of the corner (1, 1) (the single unknown)."""
+        return _corner_displacement(problem.V, problem.u)
+
+    def probe(self, problem: StrikerOnFacetProblem) -> float:
+        """What a study reports per run: the corner displacement u."""
+        return self.corner_displacement(problem)
+
+    def exact_dofs(self, problem: StrikerOnFacetProblem) -> np.ndarray:
+        """Dof values of the exact displacement: only the corner moves."""
+        return _corner_dofs(problem.V, self.exact_u)
 
 
 @dataclass(frozen=True)
 class WedgeOnCorner:
-    """Example 1 analog: one element, one degree of freedom, one contact node.
+    """The former Example 1 analog (``paper-ex1-wedge``): a rigid wedge instead of a striker.
 
     A unit plane-strain quadrilateral [0, 1]^2 is clamped on its left and
     bottom faces; its right face can only move vertically, so the only free
@@ -45,6 +156,9 @@ class WedgeOnCorner:
     slope: float = 2.0
     steps: int = 1
 
+    #: Paper's Table 1, for the study's side-by-side print.
+    published_table = PAPER_TABLE_1
+
     @property
     def exact_u(self) -> float:
         """The exact corner displacement, slope * h."""
@@ -57,47 +171,34 @@ class WedgeOnCorner:
     ) -> ContactProblem:
         """Create the one-element mesh and the contact problem."""
         domain = mesh.create_unit_square(comm, 1, 1, mesh.CellType.quadrilateral)
-        fdim = domain.topology.dim - 1
-
-        def side(axis: int, value: float) -> np.ndarray:
-            return mesh.locate_entities_boundary(
-                domain, fdim, lambda x: np.isclose(x[axis], value)
-            )
-
+        top = mesh.locate_entities_boundary(domain, 1, lambda x: np.isclose(x[1], 1.0))
         wedge = RigidPlane(domain, [1.0, 1.0], [-self.slope, -1.0])
         return ContactProblem(
             domain,
             SaintVenantKirchhoff(E=PAPER_E, nu=PAPER_NU),
             wedge,
-            side(1, 1.0),
+            top,
             settings,
-            prescribed=[
-                PrescribedDisplacement(side(0, 0.0), (0.0, 0.0)),
-                PrescribedDisplacement(side(1, 0.0), (0.0, 0.0)),
-                PrescribedDisplacement(side(0, 1.0), (0.0, None)),
-            ],
+            prescribed=_one_free_corner(domain),
             obstacle_motion=[self.h, 0.0],
         )
 
     def corner_displacement(self, problem: ContactProblem) -> float:
         """Vertical displacement of the top-right corner (the single unknown)."""
-        coords = problem.V.tabulate_dof_coordinates()
-        corner = np.flatnonzero(np.isclose(coords[:, 0], 1.0) & np.isclose(coords[:, 1], 1.0))
-        values = problem.u.x.array.reshape(-1, 2)[corner, 1]
-        found = problem.comm.allgather(values.tolist())
-        return float(next(v for vs in found for v in vs))
+        return _corner_displacement(problem.V, problem.u)
+
+    def probe(self, problem: ContactProblem) -> float:
+        """What a study reports per run: the corner displacement u."""
+        return self.corner_displacement(problem)
 
     def exact_dofs(self, problem: ContactProblem) -> np.ndarray:
         """Dof values of the exact displacement: only the corner moves."""
-        coords = problem.V.tabulate_dof_coordinates()
-        exact = np.zeros((coords.shape[0], 2))
-        corner = np.isclose(coords[:, 0], 1.0) & np.isclose(coords[:, 1], 1.0)
-        exact[corner, 1] = self.exact_u
-        return exact.ravel()
+        return _corner_dofs(problem.V, self.exact_u)
 
 
 #: Examples the ``study`` command knows, by name.
 EXAMPLES: dict[str, type] = {
-    "paper-ex1": WedgeOnCorner,
+    "paper-ex1": StrikerOnFacet,
+    "paper-ex1-wedge": WedgeOnCorner,
     "paper-ex2": BarOnCradle,
 }
