@@ -7,7 +7,7 @@ BIN     := $(VENV)/bin
 MPIEXEC ?= $(shell [ -x $(BIN)/mpiexec ] && echo $(BIN)/mpiexec || echo mpiexec)
 OUT     ?= results
 
-.PHONY: demo test test-serial test-mpi venv meshes lint clean
+.PHONY: demo test test-serial test-mpi venv meshes lint clean paper-tables paper-ex1-geometry
 
 venv: $(VENV)/.installed
 
@@ -34,6 +34,15 @@ test-mpi: venv
 # .msh files from every meshes/*.geo (physical groups kept).
 meshes: venv
 	$(BIN)/fenics-contact mesh
+
+# The paper's Tables 1 and 2 beside ours (Example 1 also beside the wedge analog).
+paper-tables: venv
+	$(BIN)/fenics-contact study paper-ex1 --beside paper-ex1-wedge --out $(OUT)/paper-ex1
+	$(BIN)/fenics-contact study paper-ex2 --out $(OUT)/paper-ex2-study
+
+# The search that reconstructs Example 1's geometry from the paper's numbers (~2 min).
+paper-ex1-geometry: venv
+	$(BIN)/python benchmarks/paper_ex1_geometry.py --figure docs/images/paper_ex1_geometry.png
 
 lint: venv
 	$(BIN)/ruff check fenics_contact tests demos benchmarks
