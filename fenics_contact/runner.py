@@ -10,7 +10,8 @@ from pathlib import Path
 from mpi4py import MPI
 
 from fenics_contact.model.problem import ContactProblem
-from fenics_contact.output.io import StepWriter, write_json
+from fenics_contact.output.io import write_json
+from fenics_contact.output.xdmf import StepWriter
 from fenics_contact.scene.build import build_problem
 from fenics_contact.scene.schema import Scene
 from fenics_contact.solvers import make_strategy
