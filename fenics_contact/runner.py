@@ -10,6 +10,7 @@ from pathlib import Path
 from mpi4py import MPI
 
 from fenics_contact.model.problem import ContactProblem
+from fenics_contact.output.checkpoint import CheckpointWriter, identity, read_latest, restore
 from fenics_contact.output.io import write_json
 from fenics_contact.output.xdmf import StepWriter
 from fenics_contact.scene.build import build_problem
@@ -20,6 +21,7 @@ from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.predictor import Extrapolated
 from fenics_contact.solvers.stepping import PathResult, StepRecord, solve_load_path
+from fenics_contact.stop import StopRequested
 
 
 @dataclass
@@ -67,13 +69,19 @@ def run_scene(
     on_step: Callable[[StepRecord], None] | None = None,
     on_residual: Callable[[int, float], None] | None = None,
     pictures: bool | None = None,
+    resume: bool = False,
 ) -> RunOutcome:
     """Build and solve ``scene``; write DIR/solution.xdmf, summary.json and pictures.
 
-    Each converged load step is written to the XDMF file and summary.json at
-    once, so a failing step leaves the completed ones on disk.
+    Each converged load step is written (fields, checkpoint, summary.json)
+    at once, so a failing or stopped run leaves the completed ones on disk.
+    ``resume`` continues from the checkpoint in ``out`` (after its last
+    finished step); a checkpoint of another scene or process count raises
+    :class:`~fenics_contact.output.checkpoint.CheckpointError`.
     """
     start = time.perf_counter()
+    run_identity = identity(scene, comm.size)
+    marker = read_latest(out / "checkpoint", run_identity) if resume else None  # before building
     problem = build_problem(scene, comm)
     settings = SolverSettings(
         atol=scene.solver.atol, rtol=scene.solver.rtol,
@@ -85,14 +93,22 @@ def run_scene(
         strategy.kernel.set_linear_solver(  # type: ignore[attr-defined]
             LinearSolverSettings(kind="iterative")
         )
+    saved = restore(out / "checkpoint", problem, marker) if marker is not None else None
     if scene.solver.predictor == "extrapolate":
         strategy = Extrapolated(strategy)
-    writer = StepWriter(problem, out / "solution.xdmf", scene.fields)
-    done: list[StepRecord] = []
+        if saved is not None and saved.history:
+            strategy.history = saved.history
+    before = [StepRecord(**r) for r in saved.records] if saved is not None else []
+    first = saved.step + 1 if saved is not None else 1
+    writer = StepWriter(problem, out / "solution.xdmf", scene.fields, first_step=first)
+    checkpoint = CheckpointWriter(out / "checkpoint", problem, run_identity, fresh=not resume)
+    done: list[StepRecord] = list(before)
 
     def finished(step: StepRecord) -> None:
         writer.write(step.load_factor)
         done.append(step)
+        history = strategy.history if isinstance(strategy, Extrapolated) else []
+        checkpoint.write(step.step, [s.to_dict() for s in done], history)
         partial = PathResult("running", list(done))
         if comm.rank == 0:
             write_json(out / "summary.json", _summary(scene, problem, partial, 0.0))
@@ -102,10 +118,17 @@ def run_scene(
     try:
         path = solve_load_path(
             strategy, scene.solver.steps, max_cutbacks=scene.solver.max_cutbacks,
-            on_step=finished,
+            on_step=finished, first_step=first,
         )
+    except StopRequested:
+        if comm.rank == 0:
+            write_json(out / "summary.json", _summary(
+                scene, problem, PathResult("interrupted", done), time.perf_counter() - start
+            ))
+        raise
     finally:
         writer.close()
+    path = PathResult(path.status, before + path.steps)
     summary = _summary(scene, problem, path, time.perf_counter() - start)
     if comm.rank == 0:
         write_json(out / "summary.json", summary)

@@ -96,18 +96,22 @@ def solve_load_path(
     max_cutbacks: int = 4,
     on_step: Callable[[StepRecord], None] | None = None,
     on_iteration: Callable[[StepRecord, SolveResult], None] | None = None,
+    first_step: int = 1,
 ) -> PathResult:
     """Drive the load factor 0 -> 1 in ``n_steps`` increments with cut-back.
 
     ``on_step`` is called after each converged step (write results there);
-    ``on_iteration`` after each solve attempt (progress display).
+    ``on_iteration`` after each solve attempt (progress display). A resumed
+    path starts at ``first_step`` from the problem's current load factor and
+    fields (those of step ``first_step - 1``); the records returned are the
+    steps solved here.
     """
     if n_steps < 1:
         raise ValueError(f"The number of load steps must be >= 1, got {n_steps}.")
     problem = strategy.problem
     records: list[StepRecord] = []
     t = problem.load_factor
-    for k in range(1, n_steps + 1):
+    for k in range(first_step, n_steps + 1):
         target = k / n_steps
         record = StepRecord(step=k, load_factor=target, status=Status.CONVERGED.value)
         start = time.perf_counter()
