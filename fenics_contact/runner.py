@@ -100,8 +100,9 @@ def run_scene(
             strategy.history = saved.history
     before = [StepRecord(**r) for r in saved.records] if saved is not None else []
     first = saved.step + 1 if saved is not None else 1
-    writer = StepWriter(problem, out / "solution.xdmf", scene.fields, first_step=first)
+    # an old run's checkpoint goes before its step files: never one without the other
     checkpoint = CheckpointWriter(out / "checkpoint", problem, run_identity, fresh=not resume)
+    writer = StepWriter(problem, out / "solution.xdmf", scene.fields, first_step=first)
     done: list[StepRecord] = list(before)
 
     def finished(step: StepRecord) -> None:

@@ -115,7 +115,11 @@ def with_vtk(index: Path) -> list[dict]:
 def main() -> None:
     index = Path(sys.argv[1])
     reference = Path(sys.argv[2]) if len(sys.argv) > 2 else None
+    if not index.exists():  # stopped before its first load step finished
+        print(json.dumps({"h5py": [], "meshio": [], "vtk": [], "index": False}))
+        return
     print(json.dumps({
+        "index": True,
         "h5py": with_h5py(index),
         "meshio": with_meshio(index, reference),
         "vtk": with_vtk(index),

@@ -183,7 +183,10 @@ class StepWriter:
         self._grids = [
             step_grid(self.folder / f"{_step_name(k)}.xdmf", self.path) for k in kept
         ]
-        write_index(self.path, self._grids)
+        if self._grids:
+            write_index(self.path, self._grids)
+        else:  # no index until the first step is on disk
+            self.path.unlink(missing_ok=True)
 
     def _surface_field(self, name: str, values: np.ndarray) -> fem.Function:
         self._q.x.array[: values.size] = values
