@@ -39,6 +39,10 @@ from fenics_contact.scene.schema import Scene
 #: Checkpoint layout version; a reader refuses others.
 FORMAT = 1
 LATEST = "latest.json"
+_KEYS = {
+    "u", "lam", "load_factor", "history_t", "history_u", "history_lam", "u_coordinates",
+    "lam_coordinates",
+}
 
 
 class CheckpointError(ValueError):
@@ -218,8 +222,11 @@ def restore(folder: Path, problem: ContactProblem, marker: dict) -> Checkpoint:
     try:
         with np.load(path) as npz:
             data = {k: npz[k] for k in npz.files}
-    except (OSError, ValueError) as exc:
+    except (OSError, ValueError, EOFError) as exc:
         problem_here = f"process {comm.rank}: {path} unreadable ({exc})"
+    missing = sorted(_KEYS - set(data))
+    if problem_here is None and missing:
+        problem_here = f"process {comm.rank}: {path} lacks {missing}"
     if problem_here is None:
         for name, f in (("u", problem.u), ("lam", problem.lam)):
             mine = _owned_coordinates(f)
