@@ -32,6 +32,7 @@ Every decision is appended to ``SolveResult.switches``.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -80,6 +81,8 @@ class AutoStrategy:
     """GNRM at a well-scaled internal r, with line search and penalty warm start."""
 
     name = "auto"
+    #: Called with (Newton iterations so far, residual) at every check (progress display).
+    observer: Callable[[int, float], None] | None = None
 
     def __init__(
         self,
@@ -200,7 +203,7 @@ class AutoStrategy:
 
     def _newton(self, settings: SolverSettings, tally: _Tally, *, line_search: bool) -> Status:
         """Newton on the Alart-Curnier system, plain or with backtracking."""
-        monitor = ConvergenceMonitor(settings)
+        monitor = ConvergenceMonitor(settings, observer=self.observer)
         if line_search:
             status, steps = self._line_search_loop(self.kernel, monitor)
         else:
@@ -247,7 +250,9 @@ class AutoStrategy:
         if self._penalty is None:
             self._penalty = NewtonKernel(p.penalty_system())
         p.lam.x.array[:] = 0.0
-        monitor = ConvergenceMonitor(replace(settings, rtol=max(settings.rtol, 1e-6)))
+        monitor = ConvergenceMonitor(
+            replace(settings, rtol=max(settings.rtol, 1e-6)), observer=self.observer
+        )
         status, steps = self._line_search_loop(self._penalty, monitor)
         tally.iterations += steps
         tally.residuals.extend(monitor.residuals)
