@@ -6,8 +6,8 @@ whole run, or with ``--one-rank`` to a single MPI process), then reads
 every step the index names with h5py, meshio and VTK
 (tests/read_solution.py, a separate interpreter), compares each field with
 an uninterrupted run, resumes from the checkpoint and compares the Newton
-iterations of every step. The delays cover the whole run, so some kills
-land inside a step's file writes.
+iterations of every step. The delays cover the whole run, start-up and
+file writes included.
 
 Run: ``python benchmarks/kill_anywhere.py [--trials 20] [--processes 2 [--one-rank]]``.
 """
