@@ -15,9 +15,11 @@ import statistics
 import time
 from pathlib import Path
 
+import fenics_contact  # noqa: F401  (loads the DOLFINx wheel's MPI libraries: first)
+
+# isort: split
 from mpi4py import MPI
 
-import fenics_contact  # noqa: F401
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.output.io import write_json
 from fenics_contact.solvers import make_strategy

@@ -18,13 +18,15 @@ import argparse
 import time
 from pathlib import Path
 
+import fenics_contact  # noqa: F401  (loads the DOLFINx wheel's MPI libraries: first)
+
+# isort: split
 import harness
 import numpy as np
 import ufl
 from dolfinx import fem
 from hertz2d import CYLINDER, STEPS
 
-import fenics_contact  # noqa: F401  (before dolfinx)
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.problem import ContactProblem, VariationalSystem
 from fenics_contact.solvers import make_strategy

@@ -15,9 +15,11 @@ import argparse
 import time
 from pathlib import Path
 
+import fenics_contact  # noqa: F401  (loads the DOLFINx wheel's MPI libraries: first)
+
+# isort: split
 import harness
 
-import fenics_contact  # noqa: F401  (before dolfinx)
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings

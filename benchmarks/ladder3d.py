@@ -16,11 +16,13 @@ import resource
 import time
 from pathlib import Path
 
+import fenics_contact  # noqa: F401  (loads the DOLFINx wheel's MPI libraries: first)
+
+# isort: split
 import harness
 
 from mpi4py import MPI
 
-import fenics_contact  # noqa: F401  (before dolfinx)
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings

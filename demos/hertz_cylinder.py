@@ -40,6 +40,9 @@ import json
 import time
 from pathlib import Path
 
+import fenics_contact  # noqa: F401  (loads the DOLFINx wheel's MPI libraries: first)
+
+# isort: split
 import matplotlib
 
 matplotlib.use("Agg")
@@ -48,7 +51,6 @@ import numpy as np
 
 from mpi4py import MPI
 
-import fenics_contact  # noqa: F401  (loads the DOLFINx wheel's libraries first)
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings, signorini_report

@@ -23,13 +23,16 @@
 import argparse
 from pathlib import Path
 
+import fenics_contact  # noqa: F401  (loads the DOLFINx wheel's MPI libraries: first)
+
+# isort: split
 import numpy as np
 
 from mpi4py import MPI
 
-import fenics_contact  # noqa: F401  (loads the DOLFINx wheel first)
 from fenics_contact.model.contact import ContactSettings
-from fenics_contact.output.io import StepWriter, write_json
+from fenics_contact.output.io import write_json
+from fenics_contact.output.xdmf import StepWriter
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.stepping import solve_load_path

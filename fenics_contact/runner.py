@@ -1,4 +1,4 @@
-"""Run a scene: solve its load path, write XDMF, JSON and pictures as it goes."""
+"""Run a scene: solve its load path, write XDMF, JSON, checkpoints and pictures as it goes."""
 
 from __future__ import annotations
 
@@ -9,14 +9,18 @@ from pathlib import Path
 from mpi4py import MPI
 
 from fenics_contact.model.problem import ContactProblem
-from fenics_contact.output.io import StepWriter, write_json
+from fenics_contact.output.checkpoint import CheckpointWriter, identity, read_latest, restore
+from fenics_contact.output.io import write_json
+from fenics_contact.output.xdmf import StepWriter
 from fenics_contact.scene.build import build_problem
 from fenics_contact.scene.schema import Scene
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.base import SolveResult
 from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.linear import LinearSolverSettings
+from fenics_contact.solvers.predictor import Extrapolated
 from fenics_contact.solvers.stepping import RunRecord, StepRecord, solve_load_path, start_record
+from fenics_contact.stop import StopRequested
 
 
 @dataclass
@@ -54,12 +58,18 @@ def run_scene(
     on_step: Callable[[StepRecord], None] | None = None,
     on_residual: Callable[[int, float], None] | None = None,
     pictures: bool | None = None,
+    resume: bool = False,
 ) -> RunOutcome:
     """Build and solve ``scene``; write DIR/solution.xdmf, summary.json and pictures.
 
-    Each converged load step is written to the XDMF file and summary.json at
-    once, so a failing step leaves the completed ones on disk.
+    Each converged load step is written (fields, checkpoint, summary.json)
+    at once, so a failing or stopped run leaves the completed ones on disk.
+    ``resume`` continues from the checkpoint in ``out`` (after its last
+    finished step); a checkpoint of another scene or process count raises
+    :class:`~fenics_contact.output.checkpoint.CheckpointError`.
     """
+    run_identity = identity(scene, comm.size)
+    marker = read_latest(out / "checkpoint", run_identity) if resume else None  # before building
     problem = build_problem(scene, comm)
     settings = SolverSettings(
         atol=scene.solver.atol, rtol=scene.solver.rtol,
@@ -70,11 +80,20 @@ def run_scene(
         linear=LinearSolverSettings(kind=scene.solver.linear_solver),
         observer=on_residual, predictor=scene.solver.predictor,
     )
-    writer = StepWriter(problem, out / "solution.xdmf", scene.fields)
+    saved = restore(out / "checkpoint", problem, marker) if marker is not None else None
+    if isinstance(strategy, Extrapolated) and saved is not None and saved.history:
+        strategy.history = saved.history
     record = start_record(strategy)
+    record.steps = [StepRecord(**r) for r in saved.records] if saved is not None else []
+    first = saved.step + 1 if saved is not None else 1
+    # an old run's checkpoint goes before its step files: never one without the other
+    checkpoint = CheckpointWriter(out / "checkpoint", problem, run_identity, fresh=not resume)
+    writer = StepWriter(problem, out / "solution.xdmf", scene.fields, first_step=first)
 
     def finished(step: StepRecord) -> None:
         writer.write(step.load_factor)
+        history = strategy.history if isinstance(strategy, Extrapolated) else []
+        checkpoint.write(step.step, [s.to_dict() for s in record.steps], history)
         if comm.rank == 0:
             write_json(out / "summary.json", _summary(scene, record))
         if on_step is not None:
@@ -83,8 +102,13 @@ def run_scene(
     try:
         path = solve_load_path(
             strategy, scene.solver.steps, max_cutbacks=scene.solver.max_cutbacks,
-            on_step=finished, record=record,
+            on_step=finished, record=record, first_step=first,
         )
+    except StopRequested:
+        record.status = "interrupted"
+        if comm.rank == 0:
+            write_json(out / "summary.json", _summary(scene, record))
+        raise
     finally:
         writer.close()
     summary = _summary(scene, path)

@@ -7,7 +7,8 @@ import numpy as np
 from mpi4py import MPI
 
 from fenics_contact.model.contact import ContactSettings
-from fenics_contact.output.io import StepWriter, write_json
+from fenics_contact.output.io import write_json
+from fenics_contact.output.xdmf import StepWriter
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings, Status
 from fenics_contact.solvers.stepping import solve_load_path

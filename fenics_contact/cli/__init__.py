@@ -34,6 +34,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (ValueError, FileNotFoundError, RuntimeError) as exc:
         print(f"fenics-contact: error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:  # Ctrl-C outside a run's clean stop (see fenics_contact.stop)
+        print("fenics-contact: stopped by SIGINT", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

@@ -3,8 +3,52 @@
 from __future__ import annotations
 
 import argparse
+import json
+import shlex
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+from fenics_contact.stop import StopOnSignal, StopRequested
+
+if TYPE_CHECKING:
+    from fenics_contact.scene.schema import Scene
+    from fenics_contact.solvers.stepping import StepRecord
+
+
+def _resume_command(args: argparse.Namespace, out: Path, processes: int) -> str:
+    launcher = f"mpiexec -n {processes} " if processes > 1 else ""
+    scene, folder = shlex.quote(str(args.scene)), shlex.quote(str(out))
+    return f"{launcher}fenics-contact run {scene} --resume {folder}"
+
+
+def _checkpoint_step(out: Path) -> int:
+    """The last finished step of the checkpoint in ``out`` (0 when there is none)."""
+    try:
+        return int(json.loads((out / "checkpoint" / "latest.json").read_text())["step"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return 0
+
+
+def _stopped(
+    stop: StopRequested, args: argparse.Namespace, out: Path, steps: int, done: int
+) -> None:
+    """The one line a stopped run prints (rank 0): what is done, where, how to resume."""
+    from mpi4py import MPI
+
+    comm = MPI.COMM_WORLD
+    if comm.rank != 0:
+        return
+    if done:
+        where = (f"steps 1-{done} are in {out}/solution.xdmf; resume with: "
+                 f"{_resume_command(args, out, comm.size)}")
+    else:
+        where = f"no load step finished in {out}; nothing to resume, run it again"
+    print(
+        f"fenics-contact: stopped by {stop.signal_name} after {done} of {steps} load steps; "
+        f"{where}",
+        file=sys.stderr, flush=True,
+    )
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -12,28 +56,55 @@ def _run(args: argparse.Namespace) -> int:
 
     from fenics_contact.scene.schema import load_scene
 
-    scene = load_scene(args.scene)  # validation first: no mesh, no forms yet
-    out: Path = args.out or Path("results") / scene.name
+    with StopOnSignal(MPI.COMM_WORLD) as stop:
+        scene = load_scene(args.scene)  # validation first: no mesh, no forms yet
+        if args.resume is not None and args.out is not None and (
+            args.out.resolve() != args.resume.resolve()
+        ):
+            raise ValueError(
+                f"--out {args.out} and --resume {args.resume} differ: a resumed run continues "
+                "in the folder it resumes; give only --resume."
+            )
+        out: Path = args.resume or args.out or Path("results") / scene.name
+        finished = [_checkpoint_step(out) if args.resume is not None else 0]
+        try:
+            return _solve(args, scene, out, stop, finished)
+        except StopRequested as exc:
+            _stopped(exc, args, out, scene.solver.steps, finished[0])
+            return exc.exit_code
+
+
+def _solve(
+    args: argparse.Namespace, scene: Scene, out: Path, stop: StopOnSignal, finished: list[int]
+) -> int:
+    """Run ``scene`` into ``out``; ``finished[0]`` follows the last finished load step."""
     from tqdm import tqdm
+
+    from mpi4py import MPI
 
     from fenics_contact.runner import run_scene
 
+    steps = scene.solver.steps
     quiet = args.quiet or MPI.COMM_WORLD.rank != 0
     bar = tqdm(
-        total=scene.solver.steps, unit="step", desc=scene.name, disable=quiet,
+        total=steps, initial=finished[0], unit="step", desc=scene.name, disable=quiet,
         bar_format="{desc}: {n_fmt}/{total_fmt} steps |{bar}| {elapsed} {postfix}",
     )
 
     def residual(iteration: int, value: float) -> None:
         bar.set_postfix_str(f"iteration {iteration}, residual {value:.2e}", refresh=True)
+        stop.check()
 
-    def step(_record: object) -> None:
+    def step(record: StepRecord) -> None:
+        finished[0] = record.step
         bar.update(1)
+        stop.check()
 
+    stop.check()  # a signal while the scene was read
     try:
         outcome = run_scene(
             scene, out, on_step=step, on_residual=residual,
-            pictures=False if args.no_pictures else None,
+            pictures=False if args.no_pictures else None, resume=args.resume is not None,
         )
     finally:
         bar.close()
@@ -42,7 +113,7 @@ def _run(args: argparse.Namespace) -> int:
         failed = path.steps[-1]
         done = len(path.steps) - 1
         print(
-            f"fenics-contact: load step {failed.step} of {scene.solver.steps} did not converge "
+            f"fenics-contact: load step {failed.step} of {steps} did not converge "
             f"({failed.status} after {failed.cutbacks} cut-backs); steps 1-{done} are in "
             f"{out}/solution.xdmf",
             file=sys.stderr,
@@ -66,15 +137,22 @@ def register(sub: argparse._SubParsersAction) -> None:
         "run",
         help="solve a TOML scene and write XDMF, JSON and pictures",
         description="Solve the contact scene described by a TOML file. Writes "
-        "DIR/solution.xdmf (+ .h5: displacement, contact pressure, gap, active set and "
-        "von Mises stress at every load step, for ParaView), DIR/summary.json, "
-        "DIR/deformed.png (deformed body coloured by contact pressure) and "
-        "DIR/residuals.png. Exit code 0 on success, 1 when a load step fails (the "
-        "completed steps stay on disk), 2 for a bad scene.",
+        "DIR/solution.xdmf (index of DIR/solution/step_NNNN.h5: displacement, contact "
+        "pressure, gap, active set and von Mises stress at every load step, for ParaView), "
+        "DIR/checkpoint/ (to resume), DIR/summary.json, DIR/deformed.png (deformed body "
+        "coloured by contact pressure) and DIR/residuals.png. Each load step is on disk "
+        "as soon as it finishes, whatever stops the run later. Exit code 0 on success, "
+        "1 when a load step fails (the completed steps stay on disk), 2 for a bad scene "
+        "or a checkpoint that does not fit it, 130/143 when stopped by SIGINT/SIGTERM.",
     )
     run.add_argument("scene", type=Path, help="the scene file (see scenes/ for examples)")
     run.add_argument(
         "--out", type=Path, default=None, help="output folder (default results/<scene name>)"
+    )
+    run.add_argument(
+        "--resume", type=Path, default=None, metavar="DIR",
+        help="continue the run whose output folder is DIR after its last finished load "
+        "step (same scene and number of processes); the output stays in DIR",
     )
     run.add_argument("--no-pictures", action="store_true", help="skip the PNG pictures")
     run.add_argument("--quiet", action="store_true", help="no progress bar or summary line")

@@ -1,26 +1,21 @@
-"""Output: XDMF fields per load step for ParaView, JSON and CSV records.
+"""Output: JSON and CSV records, surface fields mapped onto the body.
 
-All file writing lives here. XDMF files are written as each step finishes,
-so a run that fails later keeps the steps already done.
+The XDMF fields per load step are written by :mod:`fenics_contact.output.xdmf`.
 """
 
 from __future__ import annotations
 
-import copy
 import csv
 import json
 import math
 import os
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Mapping
 from pathlib import Path
-from xml.etree import ElementTree
 
 import numpy as np
-from dolfinx import fem, io
+from dolfinx import fem
 
-from fenics_contact.model.materials import von_mises
 from fenics_contact.model.problem import ContactProblem
-from fenics_contact.scene.schema import FIELDS
 
 
 def _clean(value: object) -> object:
@@ -85,119 +80,3 @@ class SurfaceToBody:
         f.x.array[self.body_dofs] = values
         return f
 
-
-def flatten_xdmf(path: Path) -> None:
-    """Rewrite a DOLFINx XDMF file as one temporal collection with every field per step.
-
-    DOLFINx writes one collection per function and shares the mesh through
-    ``xi:include``; some readers (VTK's legacy XDMF reader, meshio) cannot
-    follow that. The rewritten file keeps the same HDF5 datasets, copies the
-    mesh's Topology and Geometry into every step and groups all attributes of
-    a time value in one grid, which ParaView shows as one dataset with all
-    fields. Safe to call repeatedly: the input is always DOLFINx's layout.
-    """
-    tree = ElementTree.parse(path)
-    domain = tree.getroot().find("Domain")
-    if domain is None:
-        return
-    grids = domain.findall("Grid")
-    mesh_grid = next((g for g in grids if g.get("GridType") == "Uniform"), None)
-    if mesh_grid is None:
-        return
-    shared = [c for c in mesh_grid if c.tag in ("Topology", "Geometry")]
-    steps: dict[str, list[ElementTree.Element]] = {}
-    for collection in (g for g in grids if g.get("CollectionType") == "Temporal"):
-        for grid in collection.findall("Grid"):
-            time = grid.find("Time")
-            if time is None:
-                continue
-            steps.setdefault(time.get("Value", "0"), []).extend(grid.findall("Attribute"))
-    if not steps:
-        return
-    for g in grids:
-        domain.remove(g)
-    series = ElementTree.SubElement(
-        domain, "Grid", Name="solution", GridType="Collection", CollectionType="Temporal"
-    )
-    for value in sorted(steps, key=float):
-        grid = ElementTree.SubElement(series, "Grid", Name="solution", GridType="Uniform")
-        for element in shared:
-            grid.append(copy.deepcopy(element))
-        ElementTree.SubElement(grid, "Time", Value=value)
-        for attribute in steps[value]:
-            grid.append(attribute)
-    ElementTree.indent(tree)
-    tmp = path.with_suffix(".xdmf.tmp")
-    tree.write(tmp, xml_declaration=True, encoding="utf-8")
-    tmp.replace(path)
-
-
-class StepWriter:
-    """Writes the chosen fields at every load step into one XDMF file (with its .h5).
-
-    Fields: displacement (P1 vector), contact_pressure, gap and active (P1
-    scalars, zero off the contact surface) and von_mises (cell-wise Cauchy
-    von Mises stress). Time is the load factor. DOLFINx rewrites the XDMF
-    index at each write, so completed steps survive a later failure.
-    """
-
-    def __init__(
-        self, problem: ContactProblem, path: Path, fields: Sequence[str] = FIELDS
-    ) -> None:
-        if problem.V.ufl_element().embedded_superdegree != 1:
-            raise ValueError("XDMF output needs P1 displacement; interpolate higher orders first.")
-        unknown = set(fields) - set(FIELDS)
-        if unknown:
-            raise ValueError(f"Unknown output fields {sorted(unknown)}; choose from {FIELDS}.")
-        if problem.comm.rank == 0:
-            path.parent.mkdir(parents=True, exist_ok=True)
-        problem.comm.Barrier()
-        self.problem = problem
-        self.path = path
-        self.fields = tuple(fields)
-        self.mapper = SurfaceToBody(problem)
-        self._q = fem.Function(problem.Q)
-        self._stress = None
-        if "von_mises" in self.fields:
-            S = fem.functionspace(problem.domain, ("DG", 0))
-            self._stress = fem.Function(S, name="von_mises")
-            sigma = problem.material.cauchy_stress(problem.u)
-            self._stress_expr = fem.Expression(von_mises(sigma), S.element.interpolation_points)
-        self.file = io.XDMFFile(problem.comm, str(path), "w")
-        self.file.write_mesh(problem.domain)
-
-    def _surface_field(self, name: str, values: np.ndarray) -> fem.Function:
-        self._q.x.array[: values.size] = values
-        self._q.x.scatter_forward()
-        return self.mapper.field(name, self._q.x.array)
-
-    def write(self, t: float) -> None:
-        """Append the current fields at load factor ``t``."""
-        p = self.problem
-        state = p.contact_state()
-        surface = {
-            "contact_pressure": state.pressure,
-            "gap": state.gap,
-            "active": state.active.astype(float),
-        }
-        for name in self.fields:
-            if name == "displacement":
-                self.file.write_function(p.u, t)
-            elif name == "von_mises":
-                assert self._stress is not None
-                self._stress.interpolate(self._stress_expr)
-                self.file.write_function(self._stress, t)
-            else:
-                self.file.write_function(self._surface_field(name, surface[name]), t)
-        self._flatten()
-
-    def _flatten(self) -> None:
-        self.problem.comm.Barrier()
-        if self.problem.comm.rank == 0:
-            flatten_xdmf(self.path)
-        self.problem.comm.Barrier()
-
-    def close(self) -> None:
-        """Close the file."""
-        self.file.close()
-        self._flatten()

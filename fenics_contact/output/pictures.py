@@ -58,32 +58,61 @@ def _contact_window(grid, bounds: np.ndarray, gdim: int) -> np.ndarray | None:
     return np.array([lo - margin, hi + margin])
 
 
-def deformed_contact_picture(problem: ContactProblem, path: Path, title: str = "") -> None:
-    """Render the deformed body coloured by contact pressure into a PNG.
+def _gathered_grid(problem: ContactProblem):
+    """The deformed body with its contact pressure, whole on rank 0 (None elsewhere).
 
-    Serial runs only (returns without drawing on more processes: the XDMF
-    file holds the whole body for ParaView).
+    Collective. Each process contributes its owned cells; nodes on partition
+    boundaries appear once per process that draws a cell there (the picture
+    does not change).
     """
     import pyvista
 
-    if problem.comm.size > 1:
-        return
-    pyvista.OFF_SCREEN = True
-    # without a display VTK warns once that X is missing, then renders off-screen
-    pyvista.vtk_verbosity("off")
     mapper = SurfaceToBody(problem)
     state = problem.contact_state()
     q = fem.Function(problem.Q)
     q.x.array[: state.pressure.size] = -state.pressure
     q.x.scatter_forward()
     pressure = mapper.field("p", q.x.array)
-    topology, cells, geometry = plot.vtk_mesh(problem.V)
-    grid = pyvista.UnstructuredGrid(topology, cells, geometry.copy())
+    topology, cell_types, geometry = plot.vtk_mesh(problem.V)
     gdim = problem.domain.geometry.dim
-    disp = np.zeros((geometry.shape[0], 3))
-    disp[:, :gdim] = problem.u.x.array.reshape(-1, gdim)
-    grid.points += disp
-    grid.point_data["contact pressure"] = pressure.x.array.copy()
+    points = np.array(geometry, dtype=np.float64).reshape(-1, 3)
+    points[:, :gdim] += problem.u.x.array.reshape(-1, gdim)
+    part = (np.asarray(topology), np.asarray(cell_types), points, pressure.x.array.copy())
+    parts = problem.comm.gather(part, root=0)
+    if parts is None:
+        return None
+    cells, types, coords, values = [], [], [], []
+    offset = 0
+    for topo, kinds, pts, val in parts:
+        if kinds.size:
+            per_cell = topo.reshape(kinds.size, -1).copy()  # one cell type a mesh
+            per_cell[:, 1:] += offset
+            cells.append(per_cell.ravel())
+        types.append(kinds)
+        coords.append(pts)
+        values.append(val)
+        offset += pts.shape[0]
+    grid = pyvista.UnstructuredGrid(
+        np.concatenate(cells), np.concatenate(types), np.concatenate(coords)
+    )
+    grid.point_data["contact pressure"] = np.concatenate(values)
+    return grid
+
+
+def deformed_contact_picture(problem: ContactProblem, path: Path, title: str = "") -> None:
+    """Render the deformed body coloured by contact pressure into a PNG.
+
+    Collective: on more processes the body is gathered to rank 0, which draws.
+    """
+    import pyvista
+
+    grid = _gathered_grid(problem)
+    if grid is None:
+        return
+    pyvista.OFF_SCREEN = True
+    # without a display VTK warns once that X is missing, then renders off-screen
+    pyvista.vtk_verbosity("off")
+    gdim = problem.domain.geometry.dim
     bounds = np.array(grid.bounds).reshape(3, 2).T
     zoom = _contact_window(grid, bounds, gdim)
     pressed = grid.point_data["contact pressure"] > 0

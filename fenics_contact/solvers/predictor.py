@@ -59,6 +59,19 @@ class Extrapolated:
         u, lam = self._state()
         self._history = [*self._history[-1:], (self.problem.load_factor, u.copy(), lam.copy())]
 
+    @property
+    def history(self) -> list[tuple[float, np.ndarray, np.ndarray]]:
+        """The converged states (load factor, u array, lam array) it extrapolates from.
+
+        Oldest first, at most two; local arrays with ghosts. Setting it (a
+        resumed run) replaces the history with copies of the given states.
+        """
+        return list(self._history)
+
+    @history.setter
+    def history(self, states: list[tuple[float, np.ndarray, np.ndarray]]) -> None:
+        self._history = [(float(t), u.copy(), lam.copy()) for t, u, lam in states[-2:]]
+
     def _at_last_converged(self) -> bool:
         if not self._history:
             return False

@@ -198,6 +198,7 @@ def solve_load_path(
     on_step: Callable[[StepRecord], None] | None = None,
     on_iteration: Callable[[StepRecord, SolveResult], None] | None = None,
     record: RunRecord | None = None,
+    first_step: int = 1,
 ) -> RunRecord:
     """Drive the load factor 0 -> 1 in ``n_steps`` increments with cut-back.
 
@@ -205,7 +206,9 @@ def solve_load_path(
     ``on_iteration`` after each solve attempt (progress display). The steps
     go into ``record`` as they finish (a fresh :func:`start_record` when
     None), so a caller holding it sees the run grow; it is returned with its
-    final status and wall time.
+    final status and wall time. A resumed path starts at ``first_step`` from
+    the problem's current load factor and fields (those of step
+    ``first_step - 1``); the record holds the steps solved here.
     """
     if n_steps < 1:
         raise ValueError(f"The number of load steps must be >= 1, got {n_steps}.")
@@ -213,7 +216,7 @@ def solve_load_path(
     run = start_record(strategy) if record is None else record
     run_start = time.perf_counter()
     t = problem.load_factor
-    for k in range(1, n_steps + 1):
+    for k in range(first_step, n_steps + 1):
         target = k / n_steps
         if target <= t + 1e-14:
             continue  # reached before (a resumed path)

@@ -1,0 +1,110 @@
+"""Checkpoints, the per-step XDMF index and the gathered picture grid, in process."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mpi4py import MPI
+
+from fenics_contact.output.checkpoint import (
+    CheckpointError,
+    CheckpointWriter,
+    identity,
+    read_latest,
+    restore,
+)
+from fenics_contact.output.xdmf import StepWriter, finished_steps
+from fenics_contact.scene.build import build_problem
+from fenics_contact.scene.schema import load_scene
+from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings
+from fenics_contact.solvers.predictor import Extrapolated
+
+SCENES = Path(__file__).parent.parent / "scenes"
+COMM = MPI.COMM_WORLD
+
+
+def shared(tmp_path):
+    return Path(COMM.bcast(str(tmp_path), root=0))
+
+
+def scene_file(folder, name, text):
+    path = folder / name
+    if COMM.rank == 0:
+        path.write_text(text)
+    COMM.Barrier()
+    return load_scene(path)
+
+
+@pytest.mark.mpi
+def test_checkpoint_round_trip_and_moved_mesh_refused(tmp_path):
+    folder = shared(tmp_path)
+    text = (SCENES / "paper_ex2.toml").read_text()
+    scene = scene_file(folder, "a.toml", text)
+    problem = build_problem(scene, COMM)
+    strategy = Extrapolated(make_strategy("gnrm", problem, SolverSettings()))
+    for t in (0.1, 0.2):
+        problem.set_load(t)
+        assert strategy.solve().converged
+    writer = CheckpointWriter(folder / "checkpoint", problem, identity(scene, COMM.size),
+                              fresh=True)
+    writer.write(2, [{"step": 1}, {"step": 2}], strategy.history)
+
+    again = build_problem(scene, COMM)
+    marker = read_latest(folder / "checkpoint", identity(scene, COMM.size))
+    saved = restore(folder / "checkpoint", again, marker)
+    assert saved.step == 2 and again.load_factor == pytest.approx(0.2, abs=0)
+    assert np.array_equal(again.u.x.array, problem.u.x.array)  # ghosts included
+    assert np.array_equal(again.lam.x.array, problem.lam.x.array)
+    assert np.abs(problem.lam.x.array).max() > 0  # in contact: the multiplier is saved
+    assert [h[0] for h in saved.history] == [0.1, 0.2]
+    for (_, u0, l0), (_, u1, l1) in zip(saved.history, strategy.history, strict=True):
+        assert np.array_equal(u0, u1) and np.array_equal(l0, l1)
+
+    # the same numbers of DOFs on a shifted bar: refused by the DOF coordinates
+    moved = scene_file(folder, "b.toml", text.replace("origin = [-3.0, 0.0]",
+                                                      "origin = [-2.9, 0.0]"))
+    with pytest.raises(CheckpointError, match="the mesh changed"):
+        restore(folder / "checkpoint", build_problem(moved, COMM), marker)
+    with pytest.raises(CheckpointError, match=r"mesh: checkpoint .*origin"):
+        read_latest(folder / "checkpoint", identity(moved, COMM.size))
+
+
+@pytest.mark.mpi
+def test_step_writer_continues_an_index_and_refuses_missing_steps(tmp_path):
+    folder = shared(tmp_path)
+    problem = build_problem(load_scene(SCENES / "paper_ex2.toml"), COMM)
+    index = folder / "solution.xdmf"
+    writer = StepWriter(problem, index)
+    for t in (0.1, 0.2, 0.3):
+        writer.write(t)
+    assert finished_steps(index) == [1, 2, 3]
+    writer = StepWriter(problem, index, first_step=3)  # step 3 is dropped, 1-2 kept
+    assert finished_steps(index) == [1, 2]
+    if COMM.rank == 0:
+        assert index.read_text().count("<Time ") == 2
+    writer.write(0.25)
+    assert finished_steps(index) == [1, 2, 3]
+    if COMM.rank == 0:
+        assert index.read_text().count("<Time ") == 3 and 'Value="0.25"' in index.read_text()
+        (folder / "solution" / "step_0002.h5").unlink()
+    COMM.Barrier()
+    with pytest.raises(ValueError, match=r"step\(s\) \[2\] are missing"):
+        StepWriter(problem, index, first_step=4)
+
+
+@pytest.mark.mpi
+def test_picture_grid_is_the_whole_deformed_body_on_rank_0():
+    from fenics_contact.output.pictures import _gathered_grid
+
+    problem = build_problem(load_scene(SCENES / "paper_ex2.toml"), COMM)
+    problem.u.interpolate(lambda x: np.vstack([0.1 * x[0], 0.0 * x[1]]))
+    grid = _gathered_grid(problem)
+    if COMM.rank != 0:
+        assert grid is None
+        return
+    assert grid.n_cells == 12  # the 6 x 2 bar, every process's cells
+    lo, hi = np.array(grid.bounds).reshape(3, 2).T
+    assert lo[:2] == pytest.approx([-3.3, 0.0]) and hi[:2] == pytest.approx([3.3, 1.0])
+    assert grid.point_data["contact pressure"].shape == (grid.n_points,)
