@@ -40,6 +40,7 @@ from dolfinx.fem import petsc as fem_petsc
 from fenics_contact.model.problem import ContactProblem
 from fenics_contact.model.scaling import residual_floor
 from fenics_contact.solvers.base import SolveResult, newton_loop, timed
+from fenics_contact.solvers.condensed import kernel_for
 from fenics_contact.solvers.diagnostics import ConvergenceMonitor, SolverSettings, Status
 from fenics_contact.solvers.newton import NewtonKernel
 
@@ -90,7 +91,7 @@ class AutoStrategy:
         self.problem = problem
         self.settings = settings
         self.auto = auto or AutoSettings()
-        self.kernel = NewtonKernel(problem.augmented_system())
+        self.kernel = kernel_for(problem.augmented_system())
         self._penalty: NewtonKernel | None = None
 
     # -- public ------------------------------------------------------------------
@@ -245,7 +246,7 @@ class AutoStrategy:
         """Penalty solve at the current r, then lam = min(r g, 0); True on success."""
         p = self.problem
         if self._penalty is None:
-            self._penalty = NewtonKernel(p.penalty_system())
+            self._penalty = kernel_for(p.penalty_system())
         p.lam.x.array[:] = 0.0
         monitor = ConvergenceMonitor(replace(settings, rtol=max(settings.rtol, 1e-6)))
         status, steps = self._line_search_loop(self._penalty, monitor)

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 from typing import Protocol
 
 from fenics_contact.model.problem import ContactProblem, VariationalSystem
+from fenics_contact.solvers.condensed import kernel_for
 from fenics_contact.solvers.diagnostics import ConvergenceMonitor, SolverSettings, Status
 from fenics_contact.solvers.newton import NewtonKernel
 
@@ -96,7 +97,7 @@ class MonolithicNewton:
     def __init__(self, problem: ContactProblem, settings: SolverSettings) -> None:
         self.problem = problem
         self.settings = settings
-        self.kernel = NewtonKernel(self.build_system(problem))
+        self.kernel = kernel_for(self.build_system(problem))
 
     def build_system(self, problem: ContactProblem) -> VariationalSystem:
         """The residual blocks this strategy solves."""

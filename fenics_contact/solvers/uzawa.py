@@ -17,8 +17,8 @@ from mpi4py import MPI
 
 from fenics_contact.model.contact import assemble_local
 from fenics_contact.model.problem import ContactProblem
+from fenics_contact.solvers.condensed import kernel_for
 from fenics_contact.solvers.diagnostics import SolverSettings
-from fenics_contact.solvers.newton import NewtonKernel
 
 
 class UzawaBase:
@@ -31,7 +31,7 @@ class UzawaBase:
     def __init__(self, problem: ContactProblem, settings: SolverSettings) -> None:
         self.problem = problem
         self.settings = settings
-        self.kernel = NewtonKernel(problem.primal_system())
+        self.kernel = kernel_for(problem.primal_system())
         self._complementarity = fem.form(
             problem.complementarity_residual(), entity_maps=problem.surface.entity_maps
         )
