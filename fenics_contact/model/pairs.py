@@ -203,7 +203,7 @@ class DeformablePair:
         """Search, then fill X_k and w_k; True when the assignment changed on any rank."""
         w_t = self.target_displacements()
         current = (self.X_vertices + w_t)[self.facet_vertex]
-        proj = SurfaceSearch(current).closest(self.striker_positions())
+        proj = SurfaceSearch(current).closest(self.striker_positions(), previous=self.assignment)
         self.search_count += 1
         self.projection = proj
         facet = proj.facet

@@ -32,6 +32,8 @@ import numpy as np
 
 #: Relative tolerance (of the facet size) under which two clamped distances tie.
 TIE_TOL = 1e-10
+#: Hysteresis of the assignment (local coordinates; see SurfaceSearch.closest).
+KEEP = 0.05
 
 
 @dataclass(frozen=True)
@@ -135,8 +137,18 @@ class SurfaceSearch:
         self.tree = cKDTree(self.centroids)
         self.k = int(min(candidates, m))
 
-    def closest(self, points: np.ndarray) -> Projection:
-        """Assign a facet to every point with the corner rule of the module."""
+    def closest(
+        self, points: np.ndarray, previous: np.ndarray | None = None, keep: float = KEEP
+    ) -> Projection:
+        """Assign a facet to every point with the corner rule of the module.
+
+        ``previous``: the facets assigned before (-1: none). A point keeps its
+        previous facet while that facet's unclamped projection leaves it by at
+        most ``keep`` (in local coordinates) and its clamped distance exceeds
+        the best by at most ``keep`` times the facet size: the hysteresis
+        that stops a node in contact at a convex vertex from flipping between
+        the two facets from one Newton iteration to the next.
+        """
         points = np.asarray(points, float)
         n = points.shape[0]
         if n == 0:
@@ -155,6 +167,18 @@ class SurfaceSearch:
             near = np.asarray(self.tree.query_ball_point(points[i], reach[i]), np.int64)
             f, x, d, o = self._pick(points[i : i + 1], near[None, :])
             facet[i], xi[i], dist[i], over[i] = f[0], x[0], d[0], o[0]
+        if previous is not None and previous.size == n:
+            prev = np.asarray(previous, np.int64)
+            has = prev >= 0
+            if np.any(has):
+                rows = np.flatnonzero(has)
+                xp, dp, op = project(points[rows], self.vertices[prev[rows]][:, None])
+                length = np.linalg.norm(
+                    self.vertices[prev[rows], 1] - self.vertices[prev[rows], 0], axis=-1)
+                ok = (op[:, 0] <= keep) & (dp[:, 0] <= dist[rows] + keep * length)
+                sel = rows[ok]
+                facet[sel] = prev[sel]
+                xi[sel], dist[sel], over[sel] = xp[ok, 0], dp[ok, 0], op[ok, 0]
         return Projection(facet, xi, dist, over)
 
     def _pick(self, points: np.ndarray, idx: np.ndarray):

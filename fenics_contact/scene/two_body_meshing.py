@@ -134,8 +134,8 @@ def block_on_block(
             geo.mesh.setTransfiniteSurface(s)
             out[name] = (lines, s)
         geo.synchronize()
-        (lb, lr, lt, ll), ls = out["lower"]
-        (ub, ur, ut, ul), us = out["upper"]
+        (lb, _, lt, ll), ls = out["lower"]
+        (ub, _, ut, ul), us = out["upper"]
         gmsh.model.addPhysicalGroup(2, [us], STRIKER_TAG, name="striker")
         gmsh.model.addPhysicalGroup(2, [ls], TARGET_TAG, name="target")
         gmsh.model.addPhysicalGroup(1, [ut], LOAD_TAG, name="top")
