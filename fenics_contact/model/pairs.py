@@ -67,6 +67,24 @@ class Body:
     material: Elastic
 
 
+@dataclass(frozen=True)
+class PathDisplacement(PrescribedDisplacement):
+    """A prescribed displacement along a piecewise-linear path in the load factor.
+
+    Attributes:
+        path: knots (t, u_1, ..., u_d), t increasing from 0 to 1 (length units);
+            ``value`` (the end point) is unused.
+    """
+
+    path: tuple[tuple[float, ...], ...] = ()
+
+    def at(self, t: float) -> np.ndarray:
+        """Displacement at load factor t (linear between knots)."""
+        knots = np.asarray(self.path, float)
+        return np.array([np.interp(t, knots[:, 0], knots[:, 1 + i])
+                         for i in range(knots.shape[1] - 1)])
+
+
 def _node_to_block(V: fem.FunctionSpace) -> np.ndarray:
     """Local block (vertex dof) of V at each local geometry node (P1 on a P1 mesh)."""
     geo = V.mesh.geometry
@@ -301,7 +319,17 @@ class TwoBodyProblem(ContactProblem):
         self.load_factor = 0.0
         self._motion = np.zeros(gdim)
         self._bc_constants = []
-        self.bcs = self._dirichlet(prescribed)
+        self._path_constants: list[tuple[fem.Constant, PathDisplacement, int]] = []
+        fixed = [c for c in prescribed if not isinstance(c, PathDisplacement)]
+        self.bcs = self._dirichlet(fixed)
+        for c in prescribed:
+            if isinstance(c, PathDisplacement):
+                for i in range(gdim):
+                    Vi = self.V.sub(i)
+                    dofs = fem.locate_dofs_topological(Vi, gdim - 1, c.facets)
+                    const = fem.Constant(domain, default_scalar_type(0.0))
+                    self._path_constants.append((const, c, i))
+                    self.bcs.append(fem.dirichletbc(const, dofs, Vi))
         self._traction_constants = []
         external = self._external_work(tractions)
 
@@ -338,6 +366,8 @@ class TwoBodyProblem(ContactProblem):
             const.value = t * value
         for const, value in self._traction_constants:
             const.value[:] = t * value
+        for const, condition, i in self._path_constants:
+            const.value = condition.at(t)[i]
 
     def body_ids(self) -> fem.Function:
         """Cell-wise body index (0, 1, ...) in the order of ``bodies`` (DG0)."""
