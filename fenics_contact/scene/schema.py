@@ -34,6 +34,7 @@ zmax = 6. Tags may be given by number or by name.
 from __future__ import annotations
 
 import difflib
+import itertools
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -387,7 +388,7 @@ def _path(reader: _Reader, dimension: int) -> tuple[tuple[float, ...], ...]:
                               + fix + ".")
         out.append(tuple(float(v) for v in k))
     ts = [k[0] for k in out]
-    if ts[0] != 0.0 or ts[-1] != 1.0 or any(b <= a for a, b in zip(ts, ts[1:], strict=False)):
+    if ts[0] != 0.0 or ts[-1] != 1.0 or any(b <= a for a, b in itertools.pairwise(ts)):
         raise reader.fail("path", f"load factors {ts} must increase from 0 to 1; " + fix + ".")
     if "value" in reader.table:
         raise reader.fail("value", "give either 'value' or 'path', not both.")
