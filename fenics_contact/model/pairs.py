@@ -170,7 +170,7 @@ class DeformablePair:
         # Striker nodes: W blocks on the submesh and their parent V blocks.
         self.W = fem.functionspace(surface.submesh, ("Lagrange", 1, (gdim,)))
         sub_geo = surface.submesh.geometry
-        parent_node = np.asarray(surface.node_map)[sub_geo.dofmaps(0).reshape(-1)]
+        parent_node = np.asarray(surface.node_map)[sub_geo.dofmaps[0].reshape(-1)]
         n_w = self.W.dofmap.index_map.size_local + self.W.dofmap.index_map.num_ghosts
         self._striker_node = np.zeros(n_w, np.int64)
         self._striker_node[self.W.dofmap.list.reshape(-1)] = parent_node
