@@ -55,6 +55,22 @@ def _summary(scene: Scene, problem: ContactProblem, path: PathResult | None, wal
         "wall_s": wall,
         "processes": problem.comm.size,
         "steps": [s.to_dict() for s in steps],
+        "pairs": [
+            {
+                "name": pair.name, "striker": pair.striker, "target": pair.target,
+                "steps": [
+                    {"step": s.step, "load_factor": s.load_factor,
+                     "normal_force": s.contact_force, "active_count": s.active_count,
+                     "max_penetration": s.max_penetration}
+                    for s in steps
+                ],
+            }
+            for pair in scene.pairs
+        ] if scene.two_body else [],
+        "bodies": [
+            {"name": b.name, "tag": b.tag, "law": b.law, "E": b.E, "nu": b.nu}
+            for b in scene.bodies
+        ],
     }
 
 
