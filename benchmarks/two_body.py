@@ -17,9 +17,9 @@ import json
 import time
 from pathlib import Path
 
-import fenics_contact  # noqa: F401  (before dolfinx)
 from mpi4py import MPI
 
+import fenics_contact  # noqa: F401  (before dolfinx)
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import material
 from fenics_contact.model.pairs import Body, TwoBodyProblem
