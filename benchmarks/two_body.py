@@ -7,7 +7,7 @@ Per Newton iteration: search (closest point + target coefficients), transfer
 (selection matrix, P^T R, P^T J P, Dirichlet elimination), and the whole
 kernel time. Writes results/bench/two_body.json and .md.
 
-Run: ``python benchmarks/two_body.py [--h 0.01] [--out results/bench]``.
+Run: ``python benchmarks/two_body.py [--h 0.005] [--repeats 3] [--out results/bench]``.
 """
 
 from __future__ import annotations
@@ -73,11 +73,15 @@ def one_body(h: float) -> dict:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--h", type=float, default=0.01)
+    parser.add_argument("--h", type=float, default=0.005)
     parser.add_argument("--out", type=Path, default=Path("results/bench"))
+    parser.add_argument("--repeats", type=int, default=3, help="keep the fastest run")
     args = parser.parse_args()
-    two = two_bodies(args.h)
-    one = one_body(args.h / 2**0.5)
+    # the machine is shared: keep the fastest of a few runs of each case
+    two = min((two_bodies(args.h) for _ in range(args.repeats)),
+              key=lambda d: d["per_iteration_s"])
+    one = min((one_body(args.h / 2**0.5) for _ in range(args.repeats)),
+              key=lambda d: d["per_iteration_s"])
     ratio = two["per_iteration_s"] / one["per_iteration_s"]
     record = {"h": args.h, "two_bodies": two, "one_body_rigid": one,
               "cost_ratio_per_iteration": ratio, "processes": MPI.COMM_WORLD.size}

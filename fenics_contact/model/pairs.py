@@ -183,6 +183,7 @@ class DeformablePair:
         #: Incremented whenever some striker node changes facet (on any rank).
         self.version = 0
         self.search_count = 0
+        self._searched_u: np.ndarray | None = None
 
     def _normals(self, X: np.ndarray) -> np.ndarray:
         if self.gdim == 2:
@@ -218,7 +219,14 @@ class DeformablePair:
         return x0 + self.u.x.array.reshape(-1, self.gdim)[self._striker_block]
 
     def refresh(self) -> bool:
-        """Search, then fill X_k and w_k; True when the assignment changed on any rank."""
+        """Search, then fill X_k and w_k; True when the assignment changed on any rank.
+
+        Skipped (False) when u has not changed since the last search on any rank.
+        """
+        same = self._searched_u is not None and np.array_equal(self._searched_u, self.u.x.array)
+        if self.comm.allreduce(same, op=MPI.LAND):
+            return False
+        self._searched_u = self.u.x.array.copy()
         w_t = self.target_displacements()
         current = (self.X_vertices + w_t)[self.facet_vertex]
         proj = SurfaceSearch(current).closest(self.striker_positions(), previous=self.assignment)

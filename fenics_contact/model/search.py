@@ -155,18 +155,26 @@ class SurfaceSearch:
             gd = self.vertices.shape[2]
             return Projection(np.zeros(0, np.int64), np.zeros((0, gd - 1)), np.zeros(0),
                               np.zeros(0))
-        dist_c, idx = self.tree.query(points, k=self.k)
-        dist_c = np.atleast_2d(dist_c.reshape(n, -1))
-        idx = np.atleast_2d(idx.reshape(n, -1))
-        facet, xi, dist, over = self._pick(points, idx)
-        # Facets farther than the k-th centroid may still hold the closest
-        # point; redo those points with every facet within reach.
-        reach = dist_c[:, 0] + self.rho
-        incomplete = (dist_c[:, -1] <= reach) & (self.k < self.vertices.shape[0])
-        for i in np.flatnonzero(incomplete):
-            near = np.asarray(self.tree.query_ball_point(points[i], reach[i]), np.int64)
-            f, x, d, o = self._pick(points[i : i + 1], near[None, :])
-            facet[i], xi[i], dist[i], over[i] = f[0], x[0], d[0], o[0]
+        m = self.vertices.shape[0]
+        facet = np.zeros(n, np.int64)
+        xi = np.zeros((n, self.vertices.shape[2] - 1))
+        dist = np.zeros(n)
+        over = np.zeros(n)
+        todo = np.arange(n)
+        k = self.k
+        # The closest point of a facet lies within rho of its centroid: once the
+        # k-th nearest centroid is farther than (best distance + rho), no other
+        # facet can be closer. Double k for the points where that fails.
+        while todo.size:
+            dist_c, idx = self.tree.query(points[todo], k=k)
+            dist_c = dist_c.reshape(todo.size, -1)
+            idx = idx.reshape(todo.size, -1)
+            f, x, d, o = self._pick(points[todo], idx)
+            facet[todo], xi[todo], dist[todo], over[todo] = f, x, d, o
+            if k >= m:
+                break
+            todo = todo[dist_c[:, -1] <= d + self.rho]
+            k = min(2 * k, m)
         if previous is not None and previous.size == n:
             prev = np.asarray(previous, np.int64)
             has = prev >= 0
