@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-import ufl
-from dolfinx import fem
 
 from mpi4py import MPI
 
@@ -84,17 +82,6 @@ def _blocks(n_upper: int, n_lower: int, r: float = 1.0) -> TwoBodyProblem:
     ), ft
 
 
-def _reaction(problem: TwoBodyProblem, facets: np.ndarray, component: int) -> float:
-    """Sum of the internal nodal forces on the facets' dofs (force per thickness)."""
-    v = ufl.TestFunction(problem.V)
-    vec = fem.assemble_vector(fem.form(ufl.derivative(problem.potential, problem.u, v)))
-    vec.scatter_reverse(__import__("dolfinx").la.InsertMode.add)
-    dofs = fem.locate_dofs_topological(problem.V.sub(component), 1, facets)
-    n_owned = problem.V.dofmap.index_map.size_local * 2
-    dofs = dofs[dofs < n_owned]
-    return problem.comm.allreduce(float(vec.array[dofs].sum()), op=MPI.SUM)
-
-
 def _solve(problem, method: str, steps: int) -> list:
     strategy = make_strategy(method, problem, SolverSettings())
     out = []
@@ -123,8 +110,8 @@ def test_patch_non_matching_force_balance() -> None:
     problem, ft = _blocks(8, 11)
     _solve(problem, "gnrm", 2)
     state = problem.contact_state()
-    top = _reaction(problem, ft.find(tbm.LOAD_TAG), 1)
-    bottom = _reaction(problem, ft.find(tbm.SUPPORT_TAG), 1)
+    top = problem.reaction(ft.find(tbm.LOAD_TAG))[1]
+    bottom = problem.reaction(ft.find(tbm.SUPPORT_TAG))[1]
     # the load balances through the interface: top and bottom reactions to 1e-10
     assert abs(top + bottom) <= 1e-10 * state.contact_force
     # the normal-force magnitude differs from the vertical load by the tilt of the
@@ -209,3 +196,80 @@ def test_two_cylinders_serial_counts(cylinders: dict) -> None:
 #: Measured in serial (3 steps, h = 0.02, r = 1 E/h).
 EXPECTED_ITS = [6, 3, 3]
 EXPECTED_FORCE = 1.073291683514986
+
+
+def _order(residuals: list[float], floor: float = 1e-11) -> float:
+    r = [v for v in residuals if v > floor]
+    a, b, c = r[-3:]
+    return float(np.log(c / b) / np.log(b / a))
+
+
+def test_ironing_short() -> None:
+    """Press, then slide 1.2 radii in 8 steps on a coarse mesh: every GNRM step converges, no penetration."""
+    from fenics_contact.model.pairs import PathDisplacement
+
+    md = tbm.ironing(MPI.COMM_WORLD, h_indenter=0.08, h_block=0.12)
+    ft = md.facet_tags
+    bodies = [Body("indenter", tbm.STRIKER_TAG, material("neo-hookean", 1000.0, 0.3)),
+              Body("block", tbm.TARGET_TAG, material("neo-hookean", 100.0, 0.3))]
+    path = ((0.0, 0.0, 0.0), (0.2, 0.0, -0.1), (1.0, 0.6, -0.1))
+    problem = TwoBodyProblem(
+        md.mesh, md.cell_tags, bodies, ft.find(tbm.STRIKER_FACE_TAG),
+        ft.find(tbm.TARGET_FACE_TAG), ContactSettings(r=1.0),
+        prescribed=[PrescribedDisplacement(ft.find(tbm.SUPPORT_TAG), (0.0, 0.0)),
+                    PathDisplacement(ft.find(tbm.LOAD_TAG), (None, None), path=path)],
+    )
+    from fenics_contact.solvers.predictor import Extrapolated
+    from fenics_contact.solvers.stepping import solve_load_path
+
+    strategy = Extrapolated(make_strategy("gnrm", problem, SolverSettings()))
+    orders, vertical = [], []
+
+    def check(step) -> None:
+        orders.append(_order(step.residuals[-1]))
+        assert step.max_penetration <= 1e-8 * 0.5
+        vertical.append(problem.reaction(ft.find(tbm.LOAD_TAG))[1])
+
+    path = solve_load_path(strategy, 10, max_cutbacks=3, on_step=check)
+    assert path.converged and len(orders) == 10
+    assert all(f < 0 for f in vertical[2:])  # the support keeps pushing the indenter down
+    assert np.median(orders) >= 1.8, orders
+
+
+# -- scenes ------------------------------------------------------------------------------
+def test_two_body_scenes_load() -> None:
+    from pathlib import Path
+
+    from fenics_contact.scene.schema import load_scene
+
+    root = Path(__file__).resolve().parents[1] / "scenes"
+    for name in ("two_cylinders", "block_on_block", "ironing"):
+        scene = load_scene(root / f"{name}.toml")
+        assert scene.two_body and len(scene.bodies) == 2 and len(scene.pairs) == 1
+    ironing = load_scene(root / "ironing.toml")
+    assert ironing.dirichlet[1].path[-1] == (1.0, 1.2, -0.1)
+
+
+@pytest.mark.parametrize(
+    ("edit", "message"),
+    [
+        (lambda s: s.replace('striker = "striker_arc"', ""), "needs 'striker'"),
+        (lambda s: s.replace('tag = "target"\n', ""), "needs 'tag'"),
+        (lambda s: s + '\n[contact]\ntag = "x"\n', "[contact] belongs to single-body"),
+        (lambda s: s + '\n[[pair]]\nstriker = 3\ntarget = 4\n', "one contact pair per scene"),
+        (lambda s: s.replace('value = [0.0, -0.02]', 'path = [[0.0, 0.0, 0.0], [0.5, 0.0]]'),
+         "knot [0.5, 0.0]"),
+        (lambda s: s.replace('value = [0.0, -0.02]',
+                             'path = [[0.0, 0.0, 0.0], [0.5, 0.0, 1.0]]'), "must increase"),
+    ],
+)
+def test_two_body_scene_errors(tmp_path, edit, message: str) -> None:
+    from pathlib import Path
+
+    from fenics_contact.scene.schema import SceneError, load_scene
+
+    text = (Path(__file__).resolve().parents[1] / "scenes" / "two_cylinders.toml").read_text()
+    path = tmp_path / "bad.toml"
+    path.write_text(edit(text).replace("../meshes", str(Path(__file__).parents[1] / "meshes")))
+    with pytest.raises(SceneError, match=__import__("re").escape(message)):
+        load_scene(path)

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import ufl
-from dolfinx import default_scalar_type, fem, mesh
+from dolfinx import default_scalar_type, fem, la, mesh
 
 from mpi4py import MPI
 
@@ -346,11 +346,14 @@ class TwoBodyProblem(ContactProblem):
         self.gap = self.pair.gap(x)
         self.pressure = augmented_pressure(self.gap, self.lam, self.r)
         dx = ufl.Measure("dx", domain=domain, subdomain_data=cell_tags)
+        degrees = {}
         potential = 0
         for b in bodies:
             psi = b.material.strain_energy(self.u)
-            q = energy_quadrature_degree(psi, self.u, degree)
-            potential += psi * dx(b.tag, metadata={"quadrature_degree": q})
+            degrees[b.tag] = energy_quadrature_degree(psi, self.u, degree)
+            potential += psi * dx(b.tag, metadata={"quadrature_degree": degrees[b.tag]})
+        self._dx = lambda tag: dx(tag, metadata={"quadrature_degree": degrees[tag]})
+        self._internal_form = None
         self.potential = potential
         if external is not None:
             self.potential -= external
@@ -376,6 +379,31 @@ class TwoBodyProblem(ContactProblem):
             const.value[:] = t * value
         for const, condition, i in self._path_constants:
             const.value = condition.at(t)[i]
+
+    def reaction(self, facets: np.ndarray) -> np.ndarray:
+        """Internal nodal force summed over the facets' nodes, per component (force).
+
+        With prescribed displacements on those facets this is the force the
+        support exerts on the body (per unit thickness in 2D); tractions on
+        the same facets are not included.
+        """
+        if self._internal_form is None:
+            v = ufl.TestFunction(self.V)
+            psi = None
+            for b in self.bodies:
+                term = b.material.strain_energy(self.u) * self._dx(b.tag)
+                psi = term if psi is None else psi + term
+            self._internal_form = fem.form(ufl.derivative(psi, self.u, v))
+        vec = fem.assemble_vector(self._internal_form)
+        vec.scatter_reverse(la.InsertMode.add)
+        gdim = self.domain.geometry.dim
+        n_owned = self.V.dofmap.index_map.size_local
+        out = np.zeros(gdim)
+        for i in range(gdim):
+            dofs = fem.locate_dofs_topological(self.V.sub(i), gdim - 1, facets)
+            dofs = dofs[dofs < n_owned * gdim]
+            out[i] = vec.array[dofs].sum()
+        return self.comm.allreduce(out, op=MPI.SUM)
 
     def body_ids(self) -> fem.Function:
         """Cell-wise body index (0, 1, ...) in the order of ``bodies`` (DG0)."""
