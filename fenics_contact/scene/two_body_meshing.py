@@ -195,3 +195,75 @@ def ironing(
         gmsh.model.mesh.generate(2)
 
     return mesh_on_rank(comm, rank, 2, build)
+
+
+#: Facet tag of the symmetry faces y = 0 of the hemisphere quarters (x = 0 is SYMMETRY_TAG).
+SYMMETRY_Y_TAG = 7
+
+
+def two_hemispheres(
+    comm: MPI.Comm,
+    radius: float = 1.0,
+    h_contact: float = 0.025,
+    h_far: float = 0.25,
+    fine_radius: float = 0.15,
+    coarse_radius: float = 0.6,
+    *,
+    rank: int = 0,
+) -> MeshData:
+    """Quarters (x, y >= 0) of two hemispheres touching at the origin (3D, tetrahedra).
+
+    Upper (striker): ball centre (0, 0, R), z in [0, R]; lower (target): ball
+    centre (0, 0, -R), z in [-R, 0]. Meshed independently (non-matching).
+    Facets: upper flat face z = R 2, upper sphere 3, lower sphere 4, lower
+    flat face z = -R 5, symmetry x = 0 6 and y = 0 7 (both bodies).
+    """
+    _check(radius=radius, h_contact=h_contact, h_far=h_far)
+
+    def build(gmsh) -> None:
+        gmsh.option.setNumber("General.Verbosity", 0)
+        gmsh.model.add("two_hemispheres")
+        occ = gmsh.model.occ
+        R = radius
+        upper, _ = occ.intersect([(3, occ.addSphere(0, 0, R, R))], [(3, occ.addBox(0, 0, 0, R, R, R))])
+        lower, _ = occ.intersect([(3, occ.addSphere(0, 0, -R, R))],
+                                 [(3, occ.addBox(0, 0, -R, R, R, R))])
+        occ.synchronize()
+        tol = 1e-6 * R
+        groups: dict[int, list[int]] = {t: [] for t in (LOAD_TAG, STRIKER_FACE_TAG,
+                                                          TARGET_FACE_TAG, SUPPORT_TAG,
+                                                          SYMMETRY_TAG, SYMMETRY_Y_TAG)}
+        for body, curved, flat in ((upper[0], STRIKER_FACE_TAG, LOAD_TAG),
+                                   (lower[0], TARGET_FACE_TAG, SUPPORT_TAG)):
+            for _, tag in gmsh.model.getBoundary([body], oriented=False):
+                x0, y0, z0, x1, y1, z1 = gmsh.model.getBoundingBox(2, tag)
+                if z1 - z0 < tol and abs(abs(z0) - R) < tol:
+                    groups[flat].append(tag)
+                elif x1 - x0 < tol and abs(x0) < tol:
+                    groups[SYMMETRY_TAG].append(tag)
+                elif y1 - y0 < tol and abs(y0) < tol:
+                    groups[SYMMETRY_Y_TAG].append(tag)
+                else:
+                    groups[curved].append(tag)
+        gmsh.model.addPhysicalGroup(3, [upper[0][1]], STRIKER_TAG, name="striker")
+        gmsh.model.addPhysicalGroup(3, [lower[0][1]], TARGET_TAG, name="target")
+        names = {LOAD_TAG: "top", STRIKER_FACE_TAG: "striker_cap", TARGET_FACE_TAG: "target_cap",
+                 SUPPORT_TAG: "bottom", SYMMETRY_TAG: "symmetry_x", SYMMETRY_Y_TAG: "symmetry_y"}
+        for tag, surfaces in groups.items():
+            gmsh.model.addPhysicalGroup(2, surfaces, tag, name=names[tag])
+        field = gmsh.model.mesh.field
+        d = field.add("MathEval")
+        field.setString(d, "F", "Sqrt(x*x + y*y + z*z)")
+        th = field.add("Threshold")
+        field.setNumber(th, "InField", d)
+        field.setNumber(th, "SizeMin", h_contact)
+        field.setNumber(th, "SizeMax", h_far)
+        field.setNumber(th, "DistMin", fine_radius)
+        field.setNumber(th, "DistMax", coarse_radius)
+        field.setAsBackgroundMesh(th)
+        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+        gmsh.model.mesh.generate(3)
+
+    return mesh_on_rank(comm, rank, 3, build)
