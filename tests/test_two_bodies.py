@@ -123,9 +123,19 @@ def test_patch_non_matching_force_balance() -> None:
     assert 0.2 < spread / 2.1978 < 0.3
 
 
-@pytest.mark.parametrize("method", ["penalty", "nua", "auto"])
-def test_strategies_on_two_bodies(method: str) -> None:
-    problem, _ = _blocks(8, 11)
+@pytest.mark.parametrize(("method", "r"), [("penalty", 1.0), ("nua", 1.0), ("auto", 1.0),
+                                           ("sua", 0.1)])
+def test_strategies_on_two_bodies(method: str, r: float) -> None:
+    """Every strategy on the non-matching patch (SUA cycles at r >= 1 E/h here: r = 0.1)."""
+    problem, _ = _blocks(8, 11, r=r)
+    if method == "sua":
+        strategy = make_strategy("sua", problem, SolverSettings(max_iterations=200))
+        for i in (1, 2):
+            problem.set_load(i / 2)
+            result = strategy.solve()
+            assert result.converged and result.iterations <= 120
+        assert abs(problem.contact_state().contact_force - 2.1941563995900544) < 1e-7
+        return
     its = _solve(problem, method, 2)
     state = problem.contact_state()
     if method == "penalty":  # pressure / r penetration: r = 1 E/h
