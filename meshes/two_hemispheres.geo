@@ -12,7 +12,7 @@
 
 DefineConstant[
   R = {1.0, Name "Parameters/radius"},
-  h_contact = {0.03, Name "Parameters/h_contact"},
+  h_contact = {0.02, Name "Parameters/h_contact"},
   h_far = {0.25, Name "Parameters/h_far"},
   fine_radius = {0.15, Name "Parameters/fine_radius"},
   coarse_radius = {0.6, Name "Parameters/coarse_radius"}

@@ -72,6 +72,9 @@ def _open(gmsh: Any, scene: Scene) -> None:
     gmsh.option.setNumber("General.Terminal", 0)
     for name, value in scene.mesh.parameters.items():
         gmsh.parser.setNumber(name, [float(value)])
+        # DefineConstant[x = {v, Name "Parameters/x"}] takes its value from ONELAB:
+        # gmsh 4.15 ignores parser.setNumber for such constants.
+        gmsh.onelab.setNumber(f"Parameters/{name}", [float(value)])
     gmsh.open(str(scene.mesh.file))
 
 
