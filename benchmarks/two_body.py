@@ -71,35 +71,65 @@ def one_body(h: float) -> dict:
     return _solve(cylinder.build(ContactSettings(r=1.0)))
 
 
+def two_bodies_3d(h: float) -> dict:
+    md = tbm.two_hemispheres(MPI.COMM_WORLD, h_contact=h, h_far=2.5 * h)
+    ft = md.facet_tags
+    law = material("linear", 200.0, 0.3)
+    problem = TwoBodyProblem(
+        md.mesh, md.cell_tags,
+        [Body("upper", tbm.STRIKER_TAG, law), Body("lower", tbm.TARGET_TAG, law)],
+        ft.find(tbm.STRIKER_FACE_TAG), ft.find(tbm.TARGET_FACE_TAG), ContactSettings(r=1.0),
+        prescribed=[
+            PrescribedDisplacement(ft.find(tbm.LOAD_TAG), (None, None, -0.02)),
+            PrescribedDisplacement(ft.find(tbm.SUPPORT_TAG), (None, None, 0.0)),
+            PrescribedDisplacement(ft.find(tbm.SYMMETRY_TAG), (0.0, None, None)),
+            PrescribedDisplacement(ft.find(tbm.SYMMETRY_Y_TAG), (None, 0.0, None)),
+        ],
+    )
+    return _solve(problem)
+
+
+def one_body_3d(h: float) -> dict:
+    from fenics_contact.verification.hertz_sphere import HertzSphere
+
+    sphere = HertzSphere(push=0.01, h_contact=h, h_far=2.5 * h)
+    return _solve(sphere.build(ContactSettings(r=1.0)))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--h", type=float, default=0.005)
     parser.add_argument("--out", type=Path, default=Path("results/bench"))
     parser.add_argument("--repeats", type=int, default=3, help="keep the fastest run")
+    parser.add_argument("--dim", type=int, default=2, choices=(2, 3))
     args = parser.parse_args()
     # the machine is shared: keep the fastest of a few runs of each case
-    two = min((two_bodies(args.h) for _ in range(args.repeats)),
-              key=lambda d: d["per_iteration_s"])
-    one = min((one_body(args.h / 2**0.5) for _ in range(args.repeats)),
+    if args.dim == 2:
+        pair, single, scale = two_bodies, one_body, 2**0.5
+    else:
+        pair, single, scale = two_bodies_3d, one_body_3d, 2 ** (1 / 3)
+    two = min((pair(args.h) for _ in range(args.repeats)), key=lambda d: d["per_iteration_s"])
+    one = min((single(args.h / scale) for _ in range(args.repeats)),
               key=lambda d: d["per_iteration_s"])
     ratio = two["per_iteration_s"] / one["per_iteration_s"]
-    record = {"h": args.h, "two_bodies": two, "one_body_rigid": one,
+    record = {"h": args.h, "dim": args.dim, "two_bodies": two, "one_body_rigid": one,
               "cost_ratio_per_iteration": ratio, "processes": MPI.COMM_WORLD.size}
     if MPI.COMM_WORLD.rank == 0:
         args.out.mkdir(parents=True, exist_ok=True)
-        (args.out / "two_body.json").write_text(json.dumps(record, indent=2))
+        stem = "two_body" if args.dim == 2 else "two_body_3d"
+        (args.out / f"{stem}.json").write_text(json.dumps(record, indent=2))
         md = [
-            "# Two-body cost (2D, GNRM, 10 steps)", "",
+            f"# Two-body cost ({args.dim}D, GNRM, 10 steps)", "",
             "| case | DOFs | Newton its | s / iteration | search share | transfer share |",
             "|---|---|---|---|---|---|",
-            f"| two half-cylinders | {two['dofs']} | {two['iterations']} | "
+            f"| two bodies | {two['dofs']} | {two['iterations']} | "
             f"{two['per_iteration_s']:.4f} | {two['search_share']:.1%} | "
             f"{two['transfer_share']:.1%} |",
-            f"| one on rigid plane | {one['dofs']} | {one['iterations']} | "
+            f"| one body on a rigid plane | {one['dofs']} | {one['iterations']} | "
             f"{one['per_iteration_s']:.4f} | - | - |", "",
             f"Cost ratio per Newton iteration (two / one): {ratio:.2f}", "",
         ]
-        (args.out / "two_body.md").write_text("\n".join(md))
+        (args.out / f"{stem}.md").write_text("\n".join(md))
         print("\n".join(md))
 
 

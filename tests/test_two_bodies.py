@@ -283,3 +283,40 @@ def test_two_body_scene_errors(tmp_path, edit, message: str) -> None:
     path.write_text(edit(text).replace("../meshes", str(Path(__file__).parents[1] / "meshes")))
     with pytest.raises(SceneError, match=__import__("re").escape(message)):
         load_scene(path)
+
+
+@pytest.mark.slow
+def test_two_hemispheres_hertz_coarse() -> None:
+    """3D quarter model, h = 0.05 at the poles: contact radius and peak within 3 % of Hertz.
+
+    Slow only through the first FFCx compilation of the 3D forms (about a minute).
+    """
+    from fenics_contact.verification.hertz3d import hertz_point_contact
+
+    md = tbm.two_hemispheres(MPI.COMM_WORLD, h_contact=0.05)
+    ft = md.facet_tags
+    law = material("linear", 200.0, 0.3)
+    problem = TwoBodyProblem(
+        md.mesh, md.cell_tags,
+        [Body("upper", tbm.STRIKER_TAG, law), Body("lower", tbm.TARGET_TAG, law)],
+        ft.find(tbm.STRIKER_FACE_TAG), ft.find(tbm.TARGET_FACE_TAG), ContactSettings(r=1.0),
+        prescribed=[
+            PrescribedDisplacement(ft.find(tbm.LOAD_TAG), (None, None, -0.02)),
+            PrescribedDisplacement(ft.find(tbm.SUPPORT_TAG), (None, None, 0.0)),
+            PrescribedDisplacement(ft.find(tbm.SYMMETRY_TAG), (0.0, None, None)),
+            PrescribedDisplacement(ft.find(tbm.SYMMETRY_Y_TAG), (None, 0.0, None)),
+        ],
+    )
+    its = _solve(problem, "gnrm", 2)
+    assert all(i <= 6 for i in its)
+    state = problem.contact_state()
+    assert state.max_penetration < 1e-10
+    r = np.concatenate(problem.comm.allgather(
+        np.linalg.norm(problem.nodal_coordinates()[:, :2], axis=1)))
+    p = np.concatenate(problem.comm.allgather(state.pressure))
+    fit = fit_contact_profile(r, p)
+    # two identical spheres: R_eff = R/2, E* = E / (2 (1 - nu^2)); 4 quarters
+    force = 4 * problem.comm.allreduce(state.contact_force, op=MPI.MAX)
+    hertz = hertz_point_contact(force, 0.5, 100.0, 0.3)
+    assert abs(fit.a / hertz.a - 1) < 0.03
+    assert abs(fit.p0 / hertz.p0 - 1) < 0.03

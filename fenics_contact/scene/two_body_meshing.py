@@ -225,7 +225,8 @@ def two_hemispheres(
         gmsh.model.add("two_hemispheres")
         occ = gmsh.model.occ
         R = radius
-        upper, _ = occ.intersect([(3, occ.addSphere(0, 0, R, R))], [(3, occ.addBox(0, 0, 0, R, R, R))])
+        upper, _ = occ.intersect([(3, occ.addSphere(0, 0, R, R))],
+                                 [(3, occ.addBox(0, 0, 0, R, R, R))])
         lower, _ = occ.intersect([(3, occ.addSphere(0, 0, -R, R))],
                                  [(3, occ.addBox(0, 0, -R, R, R, R))])
         occ.synchronize()
