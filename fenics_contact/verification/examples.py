@@ -17,6 +17,7 @@ from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import SaintVenantKirchhoff
 from fenics_contact.model.obstacles import RigidBall, RigidPlane
 from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
+from fenics_contact.verification.two_body_examples import BlockOnBlock, TwoCylinders
 
 #: The paper's material for both examples.
 PAPER_E = 210.0
@@ -167,4 +168,6 @@ class WedgeOnCorner:
 EXAMPLES: dict[str, type] = {
     "paper-ex1": WedgeOnCorner,
     "paper-ex2": BarOnCradle,
+    "two-cylinders": TwoCylinders,
+    "block-on-block": BlockOnBlock,
 }
