@@ -320,3 +320,18 @@ def test_two_hemispheres_hertz_coarse() -> None:
     hertz = hertz_point_contact(force, 0.5, 100.0, 0.3)
     assert abs(fit.a / hertz.a - 1) < 0.03
     assert abs(fit.p0 / hertz.p0 - 1) < 0.03
+
+
+@pytest.mark.mpi
+def test_target_force_balances_contact_force() -> None:
+    """The force handed to the target's vertices sums to the striker's contact force."""
+    problem, ft = _blocks(8, 11)
+    _solve(problem, "gnrm", 1)
+    f = problem.target_force()
+    n = problem.V.dofmap.index_map.size_local
+    total = problem.comm.allreduce(f.x.array[: 2 * n].reshape(-1, 2).sum(axis=0), op=MPI.SUM)
+    state = problem.contact_state()
+    # pressed down: the target is pushed in -y by the normal force (nearly flat interface)
+    assert abs(total[1] + state.contact_force) <= 1e-5 * state.contact_force  # facet tilt
+    bottom = problem.reaction(ft.find(tbm.SUPPORT_TAG))[1]
+    assert abs(total[1] + bottom) <= 1e-10 * state.contact_force

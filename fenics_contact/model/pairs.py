@@ -354,6 +354,7 @@ class TwoBodyProblem(ContactProblem):
             potential += psi * dx(b.tag, metadata={"quadrature_degree": degrees[b.tag]})
         self._dx = lambda tag: dx(tag, metadata={"quadrature_degree": degrees[tag]})
         self._internal_form = None
+        self._target_force_forms: list[fem.Form] | None = None
         self.potential = potential
         if external is not None:
             self.potential -= external
@@ -404,6 +405,41 @@ class TwoBodyProblem(ContactProblem):
             dofs = dofs[dofs < n_owned * gdim]
             out[i] = vec.array[dofs].sum()
         return self.comm.allreduce(out, op=MPI.SUM)
+
+    def target_force(self) -> fem.Function:
+        """Contact force the striker puts on the target's vertices (force per node).
+
+        f_target = sum_k S_k^T dL_c/dw_k with L_c the contact term: the
+        node-to-segment transfer, (1 - xi) and xi of each striker node's
+        force on its facet's vertices in 2D. Zero off the target surface.
+        """
+        if self._target_force_forms is None:
+            term = augmented_lagrangian_energy(self.gap, self.lam, self.r) * self.surface.ds
+            q = ufl.TestFunction(self.pair.W)
+            self._target_force_forms = [
+                fem.form(ufl.derivative(term, wk, q), entity_maps=self.surface.entity_maps)
+                for wk in self.pair.w
+            ]
+        self.pair.refresh()
+        from petsc4py import PETSc
+
+        gdim = self.domain.geometry.dim
+        im = self.V.dofmap.index_map
+        vec = PETSc.Vec().createMPI((im.size_local * gdim, im.size_global * gdim),
+                                    bsize=gdim, comm=self.comm)
+        vec.set(0.0)
+        for form, src in zip(self._target_force_forms, self.pair.sources(), strict=True):
+            local = fem.assemble_vector(form)
+            local.scatter_reverse(la.InsertMode.add)
+            values = local.array[: self.pair.n_owned * gdim]
+            vec.setValuesBlocked(src.astype(PETSc.IntType), values, addv=PETSc.InsertMode.ADD)
+        vec.assemblyBegin()
+        vec.assemblyEnd()
+        out = fem.Function(self.V, name="target_contact_force")
+        out.x.array[: im.size_local * gdim] = -vec.getArray(readonly=True)
+        out.x.scatter_forward()
+        vec.destroy()
+        return out
 
     def body_ids(self) -> fem.Function:
         """Cell-wise body index (0, 1, ...) in the order of ``bodies`` (DG0)."""

@@ -205,6 +205,7 @@ class StepWriter:
                 self.file.write_function(self._surface_field(name, surface[name]), t)
         if self._body_id is not None:
             self.file.write_function(self._body_id, t)
+            self.file.write_function(p.target_force(), t)
         self._flatten()
 
     def _flatten(self) -> None:
