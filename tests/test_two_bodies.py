@@ -335,3 +335,20 @@ def test_target_force_balances_contact_force() -> None:
     assert abs(total[1] + state.contact_force) <= 1e-5 * state.contact_force  # facet tilt
     bottom = problem.reaction(ft.find(tbm.SUPPORT_TAG))[1]
     assert abs(total[1] + bottom) <= 1e-10 * state.contact_force
+
+
+def test_two_body_problem_errors() -> None:
+    md = tbm.block_on_block(MPI.COMM_WORLD, n_upper=2, n_lower=2)
+    ft = md.facet_tags
+    law = material("linear", 200.0, 0.3)
+    bodies = [Body("upper", tbm.STRIKER_TAG, law), Body("lower", tbm.TARGET_TAG, law)]
+    s, t = ft.find(tbm.STRIKER_FACE_TAG), ft.find(tbm.TARGET_FACE_TAG)
+    with pytest.raises(ValueError, match="share facets"):
+        TwoBodyProblem(md.mesh, md.cell_tags, bodies, s, s, ContactSettings())
+    with pytest.raises(ValueError, match="quadrature = 'nodal'"):
+        TwoBodyProblem(md.mesh, md.cell_tags, bodies, s, t, ContactSettings(quadrature="gauss"))
+    with pytest.raises(ValueError, match="cell tag 9"):
+        TwoBodyProblem(md.mesh, md.cell_tags, [bodies[0], Body("x", 9, law)], s, t,
+                       ContactSettings())
+    with pytest.raises(ValueError, match="not among the bodies"):
+        TwoBodyProblem(md.mesh, md.cell_tags, bodies, s, t, ContactSettings(), striker="top")

@@ -306,9 +306,15 @@ class TwoBodyProblem(ContactProblem):
         self.comm = domain.comm
         self.cell_tags = cell_tags
         self.bodies = list(bodies)
-        by_name = {b.name: b for b in bodies}
-        s_body = by_name.get(striker, bodies[0]) if striker else bodies[0]
-        t_body = by_name.get(target, bodies[-1]) if target else bodies[-1]
+        comm = domain.comm
+        overlap = np.intersect1d(np.asarray(striker_facets), np.asarray(target_facets)).size
+        if comm.allreduce(overlap, op=MPI.SUM):
+            raise ValueError(
+                "The striker and target facet sets share facets; a contact pair needs two "
+                "disjoint surfaces (tag them separately)."
+            )
+        s_body = self._body_of(domain, cell_tags, bodies, striker_facets, striker, "striker")
+        t_body = self._body_of(domain, cell_tags, bodies, target_facets, target, "target")
         Es, Et = s_body.material.E, t_body.material.E
         self.pair_modulus = 2.0 * Es * Et / (Es + Et)
         self.material = s_body.material
@@ -364,6 +370,31 @@ class TwoBodyProblem(ContactProblem):
             -self.pressure * self.surface.ds, entity_maps=self.surface.entity_maps
         )
         self.pair.refresh()
+
+    @staticmethod
+    def _body_of(domain, cell_tags, bodies, facets, name, role) -> Body:
+        """The body named ``name``, or the one whose cells carry the facets."""
+        if name is not None:
+            found = [b for b in bodies if b.name == name]
+            if not found:
+                raise ValueError(
+                    f"The {role} body {name!r} is not among the bodies "
+                    f"{[b.name for b in bodies]}; use one of those names."
+                )
+            return found[0]
+        tdim = domain.topology.dim
+        domain.topology.create_connectivity(tdim - 1, tdim)
+        f2c = domain.topology.connectivity(tdim - 1, tdim)
+        tag_of = dict(zip(cell_tags.indices.tolist(), cell_tags.values.tolist(), strict=True))
+        local = {tag_of.get(int(c)) for f in np.asarray(facets) for c in f2c.links(int(f))}
+        tags = set().union(*domain.comm.allgather(local)) - {None}
+        matching = [b for b in bodies if b.tag in tags]
+        if len(matching) != 1:
+            raise ValueError(
+                f"The {role} facets border cells of {len(matching)} bodies "
+                f"({[b.name for b in matching]}); a {role} surface lies on one body."
+            )
+        return matching[0]
 
     # -- parameters and loads ---------------------------------------------------
     @property
