@@ -352,3 +352,17 @@ def test_two_body_problem_errors() -> None:
                        ContactSettings())
     with pytest.raises(ValueError, match="not among the bodies"):
         TwoBodyProblem(md.mesh, md.cell_tags, bodies, s, t, ContactSettings(), striker="top")
+
+
+def test_stability_grid_two_body_case() -> None:
+    """Two-body stability cases run through the same driver: auto at r = 1e8 E/h."""
+    from fenics_contact.studies.stability import full_grid, run_case, select
+
+    groups = {c.group for c in full_grid()}
+    assert {"two-body-r", "two-body-stiffness", "two-body-sliding"} <= groups
+    (case,) = select(full_grid(), ["two-cyl-r1e8"])
+    record = run_case(case, "auto")
+    assert record.status == "converged", record.message
+    assert record.steps_completed == 3 and record.max_penetration < 1e-10
+    assert record.iterations <= 20
+    assert abs(record.contact_force - EXPECTED_FORCE) <= 1e-6 * EXPECTED_FORCE

@@ -36,6 +36,7 @@ from fenics_contact.solvers.base import SolveResult
 from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.stepping import StepRecord, solve_load_path
 from fenics_contact.verification.bench_scenes import BarScene, BlockScene, HertzScene
+from fenics_contact.verification.two_body_examples import IroningShort, TwoCylinders
 
 #: Methods the stability grid runs by default.
 METHODS = ("penalty", "sua", "nua", "gnrm", "auto")
@@ -82,6 +83,18 @@ def full_grid() -> list[StabilityCase]:
         StabilityCase("bar-fine-48x16", "mesh", BarScene(nx=48, ny=16, law="neo-hookean")),
         StabilityCase("bar-fine-48x16-svk", "mesh", BarScene(nx=48, ny=16)),
     ]
+    # Two deformable bodies: r, stiffness ratio, grazing start (the cylinders
+    # touch at one point at t = 0) and large sliding.
+    cases += [
+        StabilityCase(f"two-cyl-r1e{e}", "two-body-r", TwoCylinders(), 10.0**e)
+        for e in range(-8, 13, 4)
+    ]
+    cases += [
+        StabilityCase(f"two-cyl-stiffness1e{e}", "two-body-stiffness",
+                      TwoCylinders(stiffness_ratio=10.0**e))
+        for e in (-3, 0, 3)
+    ]
+    cases += [StabilityCase("ironing-short", "two-body-sliding", IroningShort())]
     return cases
 
 

@@ -70,3 +70,31 @@ class BlockOnBlock:
                         PrescribedDisplacement(ft.find(tbm.SUPPORT_TAG), (None, 0.0)),
                         PrescribedDisplacement(ft.find(tbm.SYMMETRY_TAG), (0.0, None))],
         )
+
+
+@dataclass
+class IroningShort:
+    """Coarse ironing: neo-Hookean indenter (E = 1000) on a block (E = 100).
+
+    Pressed 0.1 over the first 20 % of the path, then slid ``slide`` (0.6 =
+    1.2 radii).
+    """
+
+    steps: int = 10
+    slide: float = 0.6
+
+    def build(self, settings: ContactSettings, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyProblem:
+        """Mesh indenter and block and create the problem."""
+        from fenics_contact.model.pairs import PathDisplacement
+
+        md = tbm.ironing(comm, h_indenter=0.08, h_block=0.12)
+        ft = md.facet_tags
+        bodies = [Body("indenter", tbm.STRIKER_TAG, material("neo-hookean", 1000.0, 0.3)),
+                  Body("block", tbm.TARGET_TAG, material("neo-hookean", 100.0, 0.3))]
+        path = ((0.0, 0.0, 0.0), (0.2, 0.0, -0.1), (1.0, self.slide, -0.1))
+        return TwoBodyProblem(
+            md.mesh, md.cell_tags, bodies, ft.find(tbm.STRIKER_FACE_TAG),
+            ft.find(tbm.TARGET_FACE_TAG), settings,
+            prescribed=[PrescribedDisplacement(ft.find(tbm.SUPPORT_TAG), (0.0, 0.0)),
+                        PathDisplacement(ft.find(tbm.LOAD_TAG), (None, None), path=path)],
+        )
