@@ -47,6 +47,22 @@ def _summary(scene: Scene, record: RunRecord) -> dict:
         "linear_solver": scene.solver.linear_solver,
         "load_steps": scene.solver.steps,
         **record.to_dict(),
+        "pairs": [
+            {
+                "name": pair.name, "striker": pair.striker, "target": pair.target,
+                "steps": [
+                    {"step": s.step, "load_factor": s.load_factor,
+                     "normal_force": s.contact_force, "active_count": s.active_count,
+                     "max_penetration": s.max_penetration}
+                    for s in record.steps
+                ],
+            }
+            for pair in scene.pairs
+        ] if scene.two_body else [],
+        "bodies": [
+            {"name": b.name, "tag": b.tag, "law": b.law, "E": b.E, "nu": b.nu}
+            for b in scene.bodies
+        ],
     }
 
 

@@ -62,8 +62,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "stability.png and per-run step records under cases/.",
     )
     cmd.add_argument("--cases", type=_names, default=None,
-                     help="comma-separated case names or groups (r, E, nu, steps, start, mesh); "
-                     "default: all")
+                     help="comma-separated case names or groups (r, E, nu, steps, start, mesh, "
+                     "two-body-r, two-body-stiffness, two-body-sliding); default: all")
     cmd.add_argument("--methods", type=methods, default=list(METHODS),
                      help="comma-separated strategies (default penalty,sua,nua,gnrm,auto)")
     cmd.add_argument("--max-iterations", type=int, default=100,

@@ -151,7 +151,7 @@ class ContactSurface:
         self.tags = tags if tags is not None else mesh.meshtags(
             domain, fdim, facets, np.full(facets.size, CONTACT_TAG, dtype=np.int32)
         )
-        self.submesh, self.entity_map, _, _ = mesh.create_submesh(domain, fdim, facets)
+        self.submesh, self.entity_map, _, self.node_map = mesh.create_submesh(domain, fdim, facets)
         self.Q = fem.functionspace(self.submesh, ("Lagrange", 1))
         self.ds = vertex_measure(domain, self.tags, quadrature)
         self.ds_nodal = vertex_measure(domain, self.tags, "nodal")

@@ -94,13 +94,22 @@ def _facet_tags(
 
 @dataclass
 class VariationalSystem:
-    """Residual blocks F_i(unknowns; tests) = 0 and what a solver needs to compile them."""
+    """Residual blocks F_i(unknowns; tests) = 0 and what a solver needs to compile them.
+
+    Two-body systems add ``extras``: coefficients (the target vertex
+    displacements w_k) that are a selection of ``unknowns[0]`` (w_k = S_k u),
+    with one more residual block each after the unknowns' blocks; ``transfer``
+    refreshes them (search) and names the selected blocks (``sources()``,
+    ``version``). A solver condenses them away (solvers/condensed.py).
+    """
 
     name: str
     residuals: list[ufl.Form]
     unknowns: list[fem.Function]
     bcs: list[fem.DirichletBC]
     entity_maps: list = field(default_factory=list)
+    extras: list[fem.Function] = field(default_factory=list)
+    transfer: object | None = None
 
 
 @dataclass(frozen=True)

@@ -50,7 +50,10 @@ def gap_scale(problem: ContactProblem) -> float:
     reference point; at least the mean contact facet size.
     """
     coords = problem.nodal_coordinates()[:, : problem.domain.geometry.dim]
-    point = np.asarray(problem.obstacle.point.value, dtype=float)
+    gdim = problem.domain.geometry.dim
+    # Two-body problems (no obstacle): the gap is a difference of coordinates.
+    obstacle = getattr(problem, "obstacle", None)
+    point = np.zeros(gdim) if obstacle is None else np.asarray(obstacle.point.value, float)
     local = float(np.max(np.linalg.norm(coords - point, axis=1), initial=0.0))
     u_max = float(np.max(np.abs(problem.u.x.array), initial=0.0))
     scale = problem.comm.allreduce(local, op=MPI.MAX) + problem.comm.allreduce(u_max, op=MPI.MAX)

@@ -136,10 +136,11 @@ def deformed_contact_picture(problem: ContactProblem, path: Path, title: str = "
                 render_points_as_spheres=True, point_size=9 if column else 6,
                 show_scalar_bar=False,
             )
-        plotter.add_mesh(
-            _obstacle_mesh(problem, bounds), color="#555555", line_width=3,
-            opacity=1.0 if gdim == 2 else 0.25,
-        )
+        if problem.obstacle is not None:  # two-body problems: both bodies are the grid
+            plotter.add_mesh(
+                _obstacle_mesh(problem, bounds), color="#555555", line_width=3,
+                opacity=1.0 if gdim == 2 else 0.25,
+            )
         if gdim == 2:
             plotter.view_xy()
             plotter.camera.parallel_projection = True

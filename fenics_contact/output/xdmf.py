@@ -160,11 +160,21 @@ class StepWriter:
         self.mapper = SurfaceToBody(problem)
         self._q = fem.Function(problem.Q)
         self._stress = None
+        S = fem.functionspace(problem.domain, ("DG", 0))
+        # Two-body problems: each body's law on its own cells, and a body-id field.
+        bodies = getattr(problem, "bodies", None)
+        self._body_id = problem.body_ids() if bodies else None
         if "von_mises" in self.fields:
-            S = fem.functionspace(problem.domain, ("DG", 0))
             self._stress = fem.Function(S, name="von_mises")
-            sigma = problem.material.cauchy_stress(problem.u)
-            self._stress_expr = fem.Expression(von_mises(sigma), S.element.interpolation_points)
+            laws = (
+                [(b.material, problem.cell_tags.find(b.tag)) for b in bodies] if bodies
+                else [(problem.material, None)]
+            )
+            self._stress_exprs = [
+                (fem.Expression(von_mises(law.cauchy_stress(problem.u)),
+                                S.element.interpolation_points), cells)
+                for law, cells in laws
+            ]
 
     def _prepare(self, first_step: int) -> None:
         """Rank 0: clear or check the step folder and write the index of the kept steps."""
@@ -210,10 +220,17 @@ class StepWriter:
                     file.write_function(p.u, t)
                 elif name == "von_mises":
                     assert self._stress is not None
-                    self._stress.interpolate(self._stress_expr)
+                    for expr, cells in self._stress_exprs:
+                        if cells is None:
+                            self._stress.interpolate(expr)
+                        else:
+                            self._stress.interpolate(expr, cells0=cells)
                     file.write_function(self._stress, t)
                 else:
                     file.write_function(self._surface_field(name, surface[name]), t)
+            if self._body_id is not None:
+                file.write_function(self._body_id, t)
+                file.write_function(p.target_force(), t)
         p.comm.Barrier()  # every rank's part of the HDF5 file is written and closed
         if p.comm.rank == 0:
             self._grids.append(step_grid(step_xdmf, self.path))

@@ -8,8 +8,8 @@ before any form is compiled.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from dolfinx import mesh
@@ -20,6 +20,9 @@ from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import material
 from fenics_contact.model.obstacles import RigidBall, RigidObstacle, RigidPlane
 from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement, SurfaceTraction
+
+if TYPE_CHECKING:
+    from fenics_contact.model.pairs import TwoBodyProblem
 from fenics_contact.scene.meshing import mesh_on_rank, open_geo
 from fenics_contact.scene.schema import GENERATOR_TAGS, BoundarySpec, Scene, SceneError
 
@@ -31,6 +34,8 @@ class BodyMesh:
     domain: mesh.Mesh
     facet_tags: mesh.MeshTags
     names: dict[str, int]
+    cell_tags: mesh.MeshTags | None = None
+    cell_names: dict[str, int] = field(default_factory=dict)
 
 
 def _generated(scene: Scene, comm: MPI.Comm) -> BodyMesh:
@@ -116,7 +121,11 @@ def _from_gmsh(scene: Scene, comm: MPI.Comm) -> BodyMesh:
     names = {
         name: group.tag for name, group in data.physical_groups.items() if group.dim == fdim
     }
-    return BodyMesh(data.mesh, data.facet_tags, names)
+    cell_names = {
+        name: group.tag for name, group in data.physical_groups.items()
+        if group.dim == scene.dimension
+    }
+    return BodyMesh(data.mesh, data.facet_tags, names, data.cell_tags, cell_names)
 
 
 def build_mesh(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> BodyMesh:
@@ -172,9 +181,62 @@ def contact_facets(scene: Scene, body: BodyMesh, obstacle: RigidObstacle) -> np.
     )
 
 
+def build_two_body_problem(scene: Scene, body: BodyMesh) -> TwoBodyProblem:
+    """Bodies, conditions and the contact pair of a two-body scene."""
+    from fenics_contact.model.pairs import Body, PathDisplacement, TwoBodyProblem
+
+    comm = body.domain.comm
+    if body.cell_tags is None:
+        raise SceneError(
+            f"{scene.path.name}: [[body]] needs a mesh file with physical groups for the "
+            "bodies' cells; the generated meshes hold one body."
+        )
+    present = sorted(set(comm.allreduce(body.cell_tags.values.tolist(), op=MPI.SUM)))
+    bodies = []
+    for i, spec in enumerate(scene.bodies):
+        tag = body.cell_names.get(spec.tag) if isinstance(spec.tag, str) else spec.tag
+        if tag is None or tag not in present:
+            named = ", ".join(f"{n} = {t}" for n, t in sorted(body.cell_names.items()))
+            raise SceneError(
+                f"{scene.path.name}: [[body]] {i + 1} tag = {spec.tag!r} is not a cell tag of "
+                f"the mesh; available: {named or ', '.join(map(str, present))}."
+            )
+        bodies.append(Body(spec.name, tag, material(spec.law, spec.E, spec.nu)))
+    pair = scene.pairs[0]
+    prescribed = []
+    for i, spec in enumerate(scene.dirichlet):
+        facets = _restricted(body, tagged_facets(body, scene, f"dirichlet {i + 1}", spec.tag), spec)
+        if spec.path:
+            prescribed.append(PathDisplacement(facets, spec.value, path=spec.path))
+        else:
+            prescribed.append(PrescribedDisplacement(facets, spec.value))
+    tractions = [
+        SurfaceTraction(
+            _restricted(body, tagged_facets(body, scene, f"traction {i + 1}", spec.tag), spec),
+            tuple(float(v) for v in spec.value if v is not None),
+        )
+        for i, spec in enumerate(scene.tractions)
+    ]
+    return TwoBodyProblem(
+        body.domain, body.cell_tags, bodies,
+        tagged_facets(body, scene, "pair striker", pair.striker),
+        tagged_facets(body, scene, "pair target", pair.target),
+        ContactSettings(r=pair.r, relative=pair.relative),
+        prescribed=prescribed, tractions=tractions,
+    )
+
+
 def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProblem:
     """Mesh, material, conditions, obstacle and contact surface of a scene."""
     body = build_mesh(scene, comm)
+    if scene.two_body:
+        return build_two_body_problem(scene, body)
+    for i, spec in enumerate(scene.dirichlet):
+        if spec.path:
+            raise SceneError(
+                f"{scene.path.name}: [[dirichlet]] {i + 1} path: load paths need a two-body "
+                "scene; give 'value' (proportional loading) instead."
+            )
     if body.domain.geometry.dim != scene.dimension:
         raise SceneError(
             f"{scene.path.name}: [scene] dimension = {scene.dimension} but the mesh is "

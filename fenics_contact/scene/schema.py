@@ -34,6 +34,7 @@ zmax = 6. Tags may be given by number or by name.
 from __future__ import annotations
 
 import difflib
+import itertools
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -55,11 +56,13 @@ GENERATOR_TAGS: dict[str, dict[str, int]] = {
 
 _SCHEMA: dict[str, set[str]] = {
     "": {"scene", "mesh", "material", "dirichlet", "traction", "obstacle", "contact", "solver",
-         "output"},
+         "output", "body", "pair"},
+    "body": {"name", "tag", "law", "E", "nu"},
+    "pair": {"name", "striker", "target", "r", "relative"},
     "scene": {"name", "dimension", "description"},
     "mesh": {"file", "generator", "origin", "size", "cells", "cell", "parameters"},
     "material": {"law", "E", "nu", "kinematics"},
-    "dirichlet": {"tag", "value", "x", "y", "z"},
+    "dirichlet": {"tag", "value", "x", "y", "z", "path"},
     "traction": {"tag", "value"},
     "obstacle": {"type", "point", "normal", "centre", "radius", "inside", "motion"},
     "contact": {"tag", "detect", "margin", "r", "relative", "quadrature"},
@@ -88,11 +91,38 @@ class MeshSpec:
 
 @dataclass(frozen=True)
 class BoundarySpec:
-    """A Dirichlet or traction condition on tagged facets (value at load factor 1)."""
+    """A Dirichlet or traction condition on tagged facets (value at load factor 1).
+
+    ``path``: optional knots (t, value...) of a piecewise-linear load path
+    (Dirichlet only; two-body scenes), from t = 0 to t = 1.
+    """
 
     tag: int | str
     value: tuple[float | None, ...]
     bounds: dict[int, tuple[float, float]] = field(default_factory=dict)
+    path: tuple[tuple[float, ...], ...] = ()
+
+
+@dataclass(frozen=True)
+class BodySpec:
+    """One body of a two-body scene: its cell tag (number or physical name) and law."""
+
+    name: str
+    tag: int | str
+    law: str
+    E: float
+    nu: float
+
+
+@dataclass(frozen=True)
+class PairSpec:
+    """A contact pair: striker facet tag against a target facet tag of a deformable body."""
+
+    name: str
+    striker: int | str
+    target: int | str
+    r: float = 1.0
+    relative: bool = True
 
 
 @dataclass(frozen=True)
@@ -152,6 +182,13 @@ class Scene:
     fields: tuple[str, ...] = FIELDS
     pictures: bool = True
     description: str = ""
+    bodies: tuple[BodySpec, ...] = ()
+    pairs: tuple[PairSpec, ...] = ()
+
+    @property
+    def two_body(self) -> bool:
+        """True when the scene declares deformable bodies and contact pairs."""
+        return bool(self.pairs)
 
 
 class _Reader:
@@ -330,11 +367,73 @@ def _boundary(reader: _Reader, dimension: int, allow_free: bool) -> BoundarySpec
             if lo_hi[0] > lo_hi[1]:
                 raise reader.fail(key, "must be [min, max] with min <= max.")
             bounds[axis] = (lo_hi[0], lo_hi[1])
-    return BoundarySpec(
-        tag=reader.tag("tag"),
-        value=reader.vector("value", dimension, allow_free=allow_free),
-        bounds=bounds,
-    )
+    path: tuple[tuple[float, ...], ...] = ()
+    if "path" in reader.table:
+        path = _path(reader, dimension)
+        value = path[-1][1:]
+    else:
+        value = reader.vector("value", dimension, allow_free=allow_free)
+    return BoundarySpec(tag=reader.tag("tag"), value=value, bounds=bounds, path=path)
+
+
+def _path(reader: _Reader, dimension: int) -> tuple[tuple[float, ...], ...]:
+    """Knots [t, u_1, ..., u_d] of a piecewise-linear path, t from 0 to 1 increasing."""
+    knots = reader.table["path"]
+    fix = f"give a list of [t, {', '.join('u' + 'xyz'[i] for i in range(dimension))}] " \
+          "with t increasing from 0 to 1"
+    if not isinstance(knots, list) or len(knots) < 2:
+        raise reader.fail("path", fix + ".")
+    out = []
+    for k in knots:
+        if (not isinstance(k, list) or len(k) != dimension + 1
+                or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in k)):
+            raise reader.fail("path", f"knot {k!r} is not a list of {dimension + 1} numbers; "
+                              + fix + ".")
+        out.append(tuple(float(v) for v in k))
+    ts = [k[0] for k in out]
+    if ts[0] != 0.0 or ts[-1] != 1.0 or any(b <= a for a, b in itertools.pairwise(ts)):
+        raise reader.fail("path", f"load factors {ts} must increase from 0 to 1; " + fix + ".")
+    if "value" in reader.table:
+        raise reader.fail("value", "give either 'value' or 'path', not both.")
+    return tuple(out)
+
+
+def _bodies(path: Path, data: dict[str, Any]) -> tuple[BodySpec, ...]:
+    out = []
+    for reader in _array(path, data, "body"):
+        law = reader.choice("law", tuple(sorted(MATERIALS)))
+        if "tag" not in reader.table:
+            raise SceneError(f"{path.name}: [[body]] needs 'tag', the cell tag of the body "
+                             "(a number or a physical surface/volume name).")
+        E, nu = _elastic_constants(reader)
+        out.append(BodySpec(
+            name=str(reader.table.get("name", f"body{len(out) + 1}")),
+            tag=reader.tag("tag"), law=law, E=E, nu=nu,
+        ))
+    names = [b.name for b in out]
+    if len(set(names)) != len(names):
+        raise SceneError(f"{path.name}: [[body]] names {names} repeat; name each body once.")
+    return tuple(out)
+
+
+def _pairs(path: Path, data: dict[str, Any]) -> tuple[PairSpec, ...]:
+    out = []
+    for reader in _array(path, data, "pair"):
+        for key in ("striker", "target"):
+            if key not in reader.table:
+                raise SceneError(
+                    f"{path.name}: [[pair]] needs '{key}', the facet tag of the {key} surface "
+                    "(a number or a physical curve/surface name)."
+                )
+        out.append(PairSpec(
+            name=str(reader.table.get("name", f"pair{len(out) + 1}")),
+            striker=reader.tag("striker"), target=reader.tag("target"),
+            r=_contact_r(reader), relative=reader.flag("relative", True),
+        ))
+    if len(out) > 1:
+        raise SceneError(f"{path.name}: {len(out)} [[pair]] blocks; one contact pair per scene "
+                         "is supported so far: keep one.")
+    return tuple(out)
 
 
 def _obstacle(reader: _Reader, dimension: int) -> ObstacleSpec:
@@ -411,6 +510,8 @@ def load_scene(path: Path | str) -> Scene:
         raise SceneError(
             f"{path.name}: [scene] dimension = {dimension!r}: use 2 (plane strain) or 3."
         )
+    if "pair" in data or "body" in data:
+        return _two_body_scene(path, data, head, dimension)
     material = _table(path, data, "material")
     law = material.choice("law", tuple(sorted(MATERIALS)))
     kinematics = material.choice("kinematics", ("finite", "small"), default="")
@@ -450,3 +551,45 @@ def _elastic_constants(material: _Reader) -> tuple[float, float]:
     if problem is not None:
         raise material.fail(*problem)
     return E, nu
+
+
+def _two_body_scene(path: Path, data: dict[str, Any], head: _Reader, dimension: int) -> Scene:
+    """A scene of deformable bodies ([[body]]) and contact pairs ([[pair]])."""
+    for key in ("material", "obstacle", "contact"):
+        if key in data:
+            raise SceneError(
+                f"{path.name}: [{key}] belongs to single-body scenes; with [[body]] and "
+                "[[pair]] give each body its law in [[body]] and r in [[pair]]."
+            )
+    bodies = _bodies(path, data)
+    pairs = _pairs(path, data)
+    if len(bodies) < 2:
+        raise SceneError(f"{path.name}: {len(bodies)} [[body]] block(s); a contact pair needs "
+                         "two bodies: add a [[body]] per body (name, tag, law, E, nu).")
+    if not pairs:
+        raise SceneError(f"{path.name}: no [[pair]] block; add one with striker and target "
+                         "facet tags.")
+    output = _table(path, data, "output", required=False)
+    fields = output.table.get("fields", list(FIELDS))
+    if not isinstance(fields, list) or any(f not in FIELDS for f in fields):
+        raise output.fail("fields", f"choose from {', '.join(FIELDS)}.")
+    pair = pairs[0]
+    return Scene(
+        path=path,
+        name=str(head.table.get("name", path.stem)),
+        dimension=dimension,
+        description=str(head.table.get("description", "")),
+        mesh=_mesh(path, _table(path, data, "mesh"), dimension),
+        law=bodies[0].law,
+        E=bodies[0].E,
+        nu=bodies[0].nu,
+        dirichlet=tuple(_boundary(r, dimension, True) for r in _array(path, data, "dirichlet")),
+        tractions=tuple(_boundary(r, dimension, False) for r in _array(path, data, "traction")),
+        obstacle=ObstacleSpec("none"),
+        contact=ContactSpec(tag=pair.striker, r=pair.r, relative=pair.relative),
+        solver=_solver(_table(path, data, "solver", required=False)),
+        fields=tuple(fields),
+        pictures=output.flag("pictures", True),
+        bodies=bodies,
+        pairs=pairs,
+    )

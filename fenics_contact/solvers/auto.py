@@ -41,6 +41,7 @@ from dolfinx.fem import petsc as fem_petsc
 from fenics_contact.model.problem import ContactProblem, ProblemState, VariationalSystem
 from fenics_contact.model.scaling import residual_floor
 from fenics_contact.solvers.base import NewtonStrategy, Observer, SolveResult, newton_loop, timed
+from fenics_contact.solvers.condensed import kernel_for
 from fenics_contact.solvers.diagnostics import ConvergenceMonitor, SolverSettings, Status
 from fenics_contact.solvers.newton import NewtonKernel
 
@@ -250,7 +251,7 @@ class AutoStrategy(NewtonStrategy):
         """Penalty solve at the current r, then lam = min(r g, 0); True on success."""
         p = self.problem
         if self._penalty is None:
-            self._penalty = NewtonKernel(p.penalty_system(), linear=self.linear)
+            self._penalty = kernel_for(p.penalty_system(), linear=self.linear)
         p.lam.x.array[:] = 0.0
         monitor = ConvergenceMonitor(
             replace(settings, rtol=max(settings.rtol, 1e-6)), observer=self._progress(tally)

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 from typing import Protocol
 
 from fenics_contact.model.problem import ContactProblem, VariationalSystem
+from fenics_contact.solvers.condensed import kernel_for
 from fenics_contact.solvers.diagnostics import ConvergenceMonitor, SolverSettings, Status
 from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.newton import NewtonKernel
@@ -122,7 +123,7 @@ class NewtonStrategy:
         self.settings = settings
         self.linear = linear or LinearSolverSettings()
         self.observer = observer
-        self.kernel = NewtonKernel(self.build_system(problem), linear=self.linear)
+        self.kernel = kernel_for(self.build_system(problem), linear=self.linear)
 
     def build_system(self, problem: ContactProblem) -> VariationalSystem:
         """The residual blocks this strategy's kernel solves."""

@@ -26,6 +26,8 @@ class KernelTimings:
         jacobians: Jacobian assemblies.
         linear_solves: linear systems solved.
         krylov_iterations: Krylov iterations over all solves (0 with a direct solver).
+        search_s: two-body closest-point search and filling the target coefficients.
+        transfer_s: two-body condensation: selection matrix, P^T R and P^T J P.
     """
 
     compile_s: float = 0.0
@@ -37,6 +39,8 @@ class KernelTimings:
     jacobians: int = 0
     linear_solves: int = 0
     krylov_iterations: int = 0
+    search_s: float = 0.0
+    transfer_s: float = 0.0
 
     @property
     def assembly_s(self) -> float:

@@ -35,6 +35,7 @@ from fenics_contact.solvers import STRATEGIES, make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.stepping import RunRecord, StepRecord, solve_load_path, start_record
 from fenics_contact.verification.bench_scenes import BarScene, BlockScene, HertzScene
+from fenics_contact.verification.two_body_examples import IroningShort, TwoCylinders
 
 #: Methods the stability grid runs by default.
 METHODS = tuple(STRATEGIES)
@@ -81,6 +82,18 @@ def full_grid() -> list[StabilityCase]:
         StabilityCase("bar-fine-48x16", "mesh", BarScene(nx=48, ny=16, law="neo-hookean")),
         StabilityCase("bar-fine-48x16-svk", "mesh", BarScene(nx=48, ny=16)),
     ]
+    # Two deformable bodies: r, stiffness ratio, grazing start (the cylinders
+    # touch at one point at t = 0) and large sliding.
+    cases += [
+        StabilityCase(f"two-cyl-r1e{e}", "two-body-r", TwoCylinders(), 10.0**e)
+        for e in range(-8, 13, 4)
+    ]
+    cases += [
+        StabilityCase(f"two-cyl-stiffness1e{e}", "two-body-stiffness",
+                      TwoCylinders(stiffness_ratio=10.0**e))
+        for e in (-3, 0, 3)
+    ]
+    cases += [StabilityCase("ironing-short", "two-body-sliding", IroningShort())]
     return cases
 
 

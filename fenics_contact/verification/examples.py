@@ -23,6 +23,7 @@ from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
 from fenics_contact.verification.bar import BarOnCradle
 from fenics_contact.verification.paper import PAPER_E, PAPER_NU, PAPER_TABLE_1
 from fenics_contact.verification.striker import StrikerOnFacetProblem
+from fenics_contact.verification.two_body_examples import BlockOnBlock, TwoCylinders
 
 
 def _one_free_corner(domain: mesh.Mesh) -> list[PrescribedDisplacement]:
@@ -201,4 +202,6 @@ EXAMPLES: dict[str, type] = {
     "paper-ex1": StrikerOnFacet,
     "paper-ex1-wedge": WedgeOnCorner,
     "paper-ex2": BarOnCradle,
+    "two-cylinders": TwoCylinders,
+    "block-on-block": BlockOnBlock,
 }

@@ -1,0 +1,137 @@
+"""Two-body cost: search + transfer share of a Newton iteration, and two bodies vs one.
+
+Two identical half-cylinders (node-to-segment pair, condensing kernel)
+against one half-cylinder on a rigid plane with about the same number of
+displacement DOFs (standard kernel), both GNRM, linear elastic, 10 steps.
+Per Newton iteration: search (closest point + target coefficients), transfer
+(selection matrix, P^T R, P^T J P, Dirichlet elimination), and the whole
+kernel time. Writes results/bench/two_body.json and .md.
+
+Run: ``python benchmarks/two_body.py [--h 0.005] [--repeats 3] [--out results/bench]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+from mpi4py import MPI
+
+import fenics_contact  # noqa: F401  (before dolfinx)
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.model.materials import material
+from fenics_contact.model.pairs import Body, TwoBodyProblem
+from fenics_contact.model.problem import PrescribedDisplacement
+from fenics_contact.scene import two_body_meshing as tbm
+from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings
+from fenics_contact.verification.hertz_problem import HertzCylinder
+
+STEPS = 10
+
+
+def _solve(problem) -> dict:
+    strategy = make_strategy("gnrm", problem, SolverSettings())
+    start = time.perf_counter()
+    its = 0
+    for i in range(1, STEPS + 1):
+        problem.set_load(i / STEPS)
+        result = strategy.solve()
+        assert result.converged, result.status
+        its += result.iterations
+    wall = time.perf_counter() - start
+    t = strategy.kernel.timings.to_dict()
+    kernel = sum(t[k] for k in ("residual_s", "jacobian_s", "setup_s", "solve_s",
+                                "search_s", "transfer_s"))
+    dofs = problem.V.dofmap.index_map.size_global * problem.V.dofmap.index_map_bs
+    return {"dofs": dofs, "iterations": its, "wall_s": wall, "kernel_s": kernel,
+            "per_iteration_s": wall / its, "timings": t,
+            "search_share": t["search_s"] / kernel, "transfer_share": t["transfer_s"] / kernel}
+
+
+def two_bodies(h: float) -> dict:
+    md = tbm.two_half_disks(MPI.COMM_WORLD, h_contact=h, h_far=0.1)
+    ft = md.facet_tags
+    law = material("linear", 200.0, 0.3)
+    problem = TwoBodyProblem(
+        md.mesh, md.cell_tags,
+        [Body("upper", tbm.STRIKER_TAG, law), Body("lower", tbm.TARGET_TAG, law)],
+        ft.find(tbm.STRIKER_FACE_TAG), ft.find(tbm.TARGET_FACE_TAG), ContactSettings(r=1.0),
+        prescribed=[PrescribedDisplacement(ft.find(tbm.LOAD_TAG), (0.0, -0.02)),
+                    PrescribedDisplacement(ft.find(tbm.SUPPORT_TAG), (0.0, 0.0))],
+    )
+    return _solve(problem)
+
+
+def one_body(h: float) -> dict:
+    cylinder = HertzCylinder(push=0.02, h_contact=h, fine_radius=0.15, coarse_radius=0.6,
+                             h_far=0.1 / 2**0.5)
+    return _solve(cylinder.build(ContactSettings(r=1.0)))
+
+
+def two_bodies_3d(h: float) -> dict:
+    md = tbm.two_hemispheres(MPI.COMM_WORLD, h_contact=h, h_far=2.5 * h)
+    ft = md.facet_tags
+    law = material("linear", 200.0, 0.3)
+    problem = TwoBodyProblem(
+        md.mesh, md.cell_tags,
+        [Body("upper", tbm.STRIKER_TAG, law), Body("lower", tbm.TARGET_TAG, law)],
+        ft.find(tbm.STRIKER_FACE_TAG), ft.find(tbm.TARGET_FACE_TAG), ContactSettings(r=1.0),
+        prescribed=[
+            PrescribedDisplacement(ft.find(tbm.LOAD_TAG), (None, None, -0.02)),
+            PrescribedDisplacement(ft.find(tbm.SUPPORT_TAG), (None, None, 0.0)),
+            PrescribedDisplacement(ft.find(tbm.SYMMETRY_TAG), (0.0, None, None)),
+            PrescribedDisplacement(ft.find(tbm.SYMMETRY_Y_TAG), (None, 0.0, None)),
+        ],
+    )
+    return _solve(problem)
+
+
+def one_body_3d(h: float) -> dict:
+    from fenics_contact.verification.hertz_sphere import HertzSphere
+
+    sphere = HertzSphere(push=0.01, h_contact=h, h_far=2.5 * h)
+    return _solve(sphere.build(ContactSettings(r=1.0)))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--h", type=float, default=0.005)
+    parser.add_argument("--out", type=Path, default=Path("results/bench"))
+    parser.add_argument("--repeats", type=int, default=3, help="keep the fastest run")
+    parser.add_argument("--dim", type=int, default=2, choices=(2, 3))
+    args = parser.parse_args()
+    # the machine is shared: keep the fastest of a few runs of each case
+    if args.dim == 2:
+        pair, single, scale = two_bodies, one_body, 2**0.5
+    else:
+        pair, single, scale = two_bodies_3d, one_body_3d, 2 ** (1 / 3)
+    two = min((pair(args.h) for _ in range(args.repeats)), key=lambda d: d["per_iteration_s"])
+    one = min((single(args.h / scale) for _ in range(args.repeats)),
+              key=lambda d: d["per_iteration_s"])
+    ratio = two["per_iteration_s"] / one["per_iteration_s"]
+    record = {"h": args.h, "dim": args.dim, "two_bodies": two, "one_body_rigid": one,
+              "cost_ratio_per_iteration": ratio, "processes": MPI.COMM_WORLD.size}
+    if MPI.COMM_WORLD.rank == 0:
+        args.out.mkdir(parents=True, exist_ok=True)
+        stem = "two_body" if args.dim == 2 else "two_body_3d"
+        (args.out / f"{stem}.json").write_text(json.dumps(record, indent=2))
+        md = [
+            f"# Two-body cost ({args.dim}D, GNRM, 10 steps)", "",
+            "| case | DOFs | Newton its | s / iteration | search share | transfer share |",
+            "|---|---|---|---|---|---|",
+            f"| two bodies | {two['dofs']} | {two['iterations']} | "
+            f"{two['per_iteration_s']:.4f} | {two['search_share']:.1%} | "
+            f"{two['transfer_share']:.1%} |",
+            f"| one body on a rigid plane | {one['dofs']} | {one['iterations']} | "
+            f"{one['per_iteration_s']:.4f} | - | - |", "",
+            f"Cost ratio per Newton iteration (two / one): {ratio:.2f}", "",
+        ]
+        (args.out / f"{stem}.md").write_text("\n".join(md))
+        print("\n".join(md))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,200 @@
+"""Closest-point search of striker nodes on a target surface (node-to-segment).
+
+The target surface is a set of straight facets: segments in 2D, triangles in
+3D, each given by its vertex positions in the current configuration and
+oriented so that the vertex order gives the outward normal
+(2D: ``n = perp(b - a)`` with ``perp(t) = (t_y, -t_x)``; 3D:
+``n = (b - a) x (c - a)``).
+
+Search: a k-d tree (``scipy.spatial.cKDTree``) on the facet centroids. The
+closest point of a facet lies at most ``d0 + rho`` from its centroid, with
+``d0`` the distance to the nearest centroid and ``rho`` the largest
+centroid-to-vertex distance, so every facet that can hold the closest point
+is found; the search is O(n log m) for n striker nodes and m facets.
+
+Corner rule (documented in docs/two_bodies.md): each candidate facet's
+*clamped* closest point (the projection limited to the facet) gives a
+distance; the facet with the smallest distance is assigned. Where the
+projection leaves every facet (a convex corner or edge) several facets
+share the nearest vertex at the same distance; the tie is broken by the
+smallest overshoot of the *unclamped* projection outside the facet, and the
+gap is measured from that facet's plane (its straight extension). On a flat
+or gently curved target the gap is then continuous when a node slides from
+facet to facet; at a sharp convex corner it jumps to the next facet once
+that facet's projection overshoots less.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+#: Relative tolerance (of the facet size) under which two clamped distances tie.
+TIE_TOL = 1e-10
+#: Hysteresis of the assignment (local coordinates; see SurfaceSearch.closest).
+KEEP = 0.05
+
+
+@dataclass(frozen=True)
+class Projection:
+    """Result of a search for n points.
+
+    Attributes:
+        facet: index of the assigned facet per point.
+        xi: unclamped local coordinates of the projection on the assigned
+            facet, shape (n, gdim - 1) (2D: 0 at a, 1 at b; 3D: barycentric
+            weights of b and c).
+        distance: distance to the clamped closest point (length units).
+        overshoot: how far the unclamped projection lies outside the facet
+            in local coordinates (0 inside).
+    """
+
+    facet: np.ndarray
+    xi: np.ndarray
+    distance: np.ndarray
+    overshoot: np.ndarray
+
+
+def _segment_projection(p: np.ndarray, a: np.ndarray, b: np.ndarray):
+    """Unclamped xi, clamped distance and overshoot of points p on segments (a, b)."""
+    t = b - a
+    tt = np.einsum("...i,...i->...", t, t)
+    xi = np.einsum("...i,...i->...", p - a, t) / tt
+    xc = np.clip(xi, 0.0, 1.0)
+    closest = a + xc[..., None] * t
+    dist = np.linalg.norm(p - closest, axis=-1)
+    over = np.abs(xi - xc)
+    return xi[..., None], dist, over
+
+
+def _triangle_projection(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray):
+    """Unclamped barycentric (xi_b, xi_c), clamped distance and overshoot on triangles."""
+    e1, e2 = b - a, c - a
+    d = p - a
+    g11 = np.einsum("...i,...i->...", e1, e1)
+    g12 = np.einsum("...i,...i->...", e1, e2)
+    g22 = np.einsum("...i,...i->...", e2, e2)
+    r1 = np.einsum("...i,...i->...", d, e1)
+    r2 = np.einsum("...i,...i->...", d, e2)
+    det = g11 * g22 - g12**2
+    s = (g22 * r1 - g12 * r2) / det
+    t = (g11 * r2 - g12 * r1) / det
+    bary = np.stack([1.0 - s - t, s, t], axis=-1)
+    over = np.sum(np.maximum(-bary, 0.0), axis=-1)
+    inside = over == 0.0
+    normal_dist = np.linalg.norm(d - s[..., None] * e1 - t[..., None] * e2, axis=-1)
+    edge = np.full(s.shape, np.inf)
+    for q0, q1 in ((a, b), (b, c), (c, a)):
+        _, de, _ = _segment_projection(p, q0, q1)
+        edge = np.minimum(edge, de)
+    dist = np.where(inside, normal_dist, edge)
+    return np.stack([s, t], axis=-1), dist, over
+
+
+def project(points: np.ndarray, facets: np.ndarray) -> Projection:
+    """Closest facet for each point by brute force over the given candidates.
+
+    Args:
+        points: (n, gdim) current positions.
+        facets: (n, k, nv, gdim) candidate facet vertices per point.
+    """
+    p = points[:, None, :]
+    if facets.shape[2] == 2:
+        xi, dist, over = _segment_projection(p, facets[:, :, 0], facets[:, :, 1])
+    else:
+        xi, dist, over = _triangle_projection(p, facets[:, :, 0], facets[:, :, 1], facets[:, :, 2])
+    return xi, dist, over
+
+
+class SurfaceSearch:
+    """Closest facet of a target surface for every striker node.
+
+    Args:
+        vertices: (m, nv, gdim) current vertex positions of the target facets.
+        candidates: neighbours asked of the k-d tree first (the result does
+            not depend on it; only the speed does).
+    """
+
+    def __init__(self, vertices: np.ndarray, candidates: int = 8) -> None:
+        self.vertices = np.asarray(vertices, float)
+        m = self.vertices.shape[0]
+        if m == 0:
+            raise ValueError("The target surface has no facets.")
+        self.centroids = self.vertices.mean(axis=1)
+        self.rho = float(
+            np.max(np.linalg.norm(self.vertices - self.centroids[:, None, :], axis=-1))
+        )
+        self.size = float(np.max(np.linalg.norm(
+            self.vertices[:, 1] - self.vertices[:, 0], axis=-1)))
+        try:
+            from scipy.spatial import cKDTree
+        except ImportError as err:  # pragma: no cover - depends on the install
+            raise ImportError(
+                "Two-body contact searches with scipy.spatial.cKDTree; install it with "
+                "`pip install fenics-contact[bodies]` (or `pip install scipy`)."
+            ) from err
+        self.tree = cKDTree(self.centroids)
+        self.k = int(min(candidates, m))
+
+    def closest(
+        self, points: np.ndarray, previous: np.ndarray | None = None, keep: float = KEEP
+    ) -> Projection:
+        """Assign a facet to every point with the corner rule of the module.
+
+        ``previous``: the facets assigned before (-1: none). A point keeps its
+        previous facet while that facet's unclamped projection leaves it by at
+        most ``keep`` (in local coordinates) and its clamped distance exceeds
+        the best by at most ``keep`` times the facet size: the hysteresis
+        that stops a node in contact at a convex vertex from flipping between
+        the two facets from one Newton iteration to the next.
+        """
+        points = np.asarray(points, float)
+        n = points.shape[0]
+        if n == 0:
+            gd = self.vertices.shape[2]
+            return Projection(np.zeros(0, np.int64), np.zeros((0, gd - 1)), np.zeros(0),
+                              np.zeros(0))
+        m = self.vertices.shape[0]
+        facet = np.zeros(n, np.int64)
+        xi = np.zeros((n, self.vertices.shape[2] - 1))
+        dist = np.zeros(n)
+        over = np.zeros(n)
+        todo = np.arange(n)
+        k = self.k
+        # The closest point of a facet lies within rho of its centroid: once the
+        # k-th nearest centroid is farther than (best distance + rho), no other
+        # facet can be closer. Double k for the points where that fails.
+        while todo.size:
+            dist_c, idx = self.tree.query(points[todo], k=k)
+            dist_c = dist_c.reshape(todo.size, -1)
+            idx = idx.reshape(todo.size, -1)
+            f, x, d, o = self._pick(points[todo], idx)
+            facet[todo], xi[todo], dist[todo], over[todo] = f, x, d, o
+            if k >= m:
+                break
+            todo = todo[dist_c[:, -1] <= d + self.rho]
+            k = min(2 * k, m)
+        if previous is not None and previous.size == n:
+            prev = np.asarray(previous, np.int64)
+            has = prev >= 0
+            if np.any(has):
+                rows = np.flatnonzero(has)
+                xp, dp, op = project(points[rows], self.vertices[prev[rows]][:, None])
+                length = np.linalg.norm(
+                    self.vertices[prev[rows], 1] - self.vertices[prev[rows], 0], axis=-1)
+                ok = (op[:, 0] <= keep) & (dp[:, 0] <= dist[rows] + keep * length)
+                sel = rows[ok]
+                facet[sel] = prev[sel]
+                xi[sel], dist[sel], over[sel] = xp[ok, 0], dp[ok, 0], op[ok, 0]
+        return Projection(facet, xi, dist, over)
+
+    def _pick(self, points: np.ndarray, idx: np.ndarray):
+        xi, dist, over = project(points, self.vertices[idx])
+        tol = TIE_TOL * self.size
+        best = dist.min(axis=1, keepdims=True)
+        # Among facets within the tie tolerance, the least overshoot wins.
+        key = np.where(dist <= best + tol, over, np.inf)
+        j = np.argmin(key, axis=1)
+        rows = np.arange(points.shape[0])
+        return idx[rows, j], xi[rows, j], dist[rows, j], over[rows, j]

@@ -1,0 +1,237 @@
+"""The Newton kernel for two-body systems: extended UFL blocks condensed by selection.
+
+A two-body :class:`~fenics_contact.model.problem.VariationalSystem` has the
+usual unknowns (u[, lam]) plus ``extras`` w_k, the displacements of each
+striker node's assigned target vertices, with w_k = S_k u (S_k a 0/1
+selection). The kernel assembles the extended residual R_ext and Jacobian
+J_ext (every block a ``ufl.derivative``, empty blocks skipped) and condenses
+them with P = [[I, 0], [0, I], [S_1, 0], ...]:
+
+    R = P^T R_ext,    J = P^T J_ext P     (PETSc MatPtAP)
+
+The symbolic product is redone only when the search changes an assignment
+(``transfer.version``). Dirichlet rows and columns are set after the product
+(S couples target vertices that may carry prescribed values): rows hold
+x - x_D and the columns are eliminated with PETSc's ``zeroRowsColumns``,
+which also lifts the right-hand side. The residual norm is that of the
+condensed residual with those rows, the measure of :class:`NewtonKernel`.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import ufl.algorithms
+from dolfinx import fem
+from dolfinx.fem import petsc as fem_petsc
+
+from petsc4py import PETSc
+
+from fenics_contact.model.problem import VariationalSystem
+from fenics_contact.solvers.linear import LinearSolverSettings
+from fenics_contact.solvers.newton import NewtonKernel
+from fenics_contact.solvers.timing import KernelTimings, stopwatch
+
+_prefix_counter = itertools.count()
+
+
+def _nonempty(form: ufl.Form | None) -> ufl.Form | None:
+    """``None`` for a derivative block that vanishes identically."""
+    if form is None:
+        return None
+    return None if ufl.algorithms.expand_derivatives(form).empty() else form
+
+
+def _owned(space: fem.FunctionSpace) -> int:
+    return space.dofmap.index_map.size_local * space.dofmap.index_map_bs
+
+
+class CondensedKernel(NewtonKernel):
+    """Newton on (u[, lam]) of a system extended by selected target displacements."""
+
+    def __init__(
+        self, system: VariationalSystem, linear: LinearSolverSettings | None = None
+    ) -> None:
+        self.timings = KernelTimings()
+        self.system = system
+        self.unknowns = system.unknowns
+        self.extras = system.extras
+        self.transfer = system.transfer
+        self.bcs = system.bcs
+        ext = [*self.unknowns, *self.extras]
+        comm = self.unknowns[0].function_space.mesh.comm
+        self._comm = comm
+        with stopwatch(self.timings, "compile_s"):
+            self.F_ext = fem.form(system.residuals, entity_maps=system.entity_maps)
+            blocks = fem.forms.derivative_block(system.residuals, ext)
+            blocks = [[_nonempty(f) for f in row] for row in blocks]
+            self.J_ext = fem.form(blocks, entity_maps=system.entity_maps)
+            self.A_ext = fem_petsc.create_matrix(self.J_ext, kind="mpi")
+            self.spaces = [u.function_space for u in self.unknowns]
+            self.ext_spaces = [f.function_space for f in ext]
+            self.b_ext = fem_petsc.create_vector(self.ext_spaces, kind="mpi")
+            self.b = fem_petsc.create_vector(self.spaces, kind="mpi")
+            self.x = fem_petsc.create_vector(self.spaces, kind="mpi")
+            self.dx = fem_petsc.create_vector(self.spaces, kind="mpi")
+            self.z = fem_petsc.create_vector(self.spaces, kind="mpi")
+        self._blocks = self.b.getAttr("_blocks")
+        self._prefix = f"fc_{system.name}2_{next(_prefix_counter)}_"
+        # Layouts: each rank owns its rows block after block (see linear.block_index_sets).
+        n_red = sum(_owned(V) for V in self.spaces)
+        n_ext = sum(_owned(V) for V in self.ext_spaces)
+        self._n_red, self._n_ext = n_red, n_ext
+        self._red0 = np.asarray(comm.allgather(comm.exscan(n_red) or 0), np.int64)
+        self._ext0 = int(comm.exscan(n_ext) or 0)
+        self._N_red, self._N_ext = comm.allreduce(n_red), comm.allreduce(n_ext)
+        im = self.spaces[0].dofmap.index_map
+        self._bs = self.spaces[0].dofmap.index_map_bs
+        self._vranges = np.asarray(comm.allgather(im.local_range[0]), np.int64)
+        n_u = _owned(self.spaces[0])
+        bc_dofs = [bc.dof_indices()[0][: bc.dof_indices()[1]] for bc in self.bcs]
+        self._bc_local = (
+            np.unique(np.concatenate(bc_dofs)).astype(np.int32) if bc_dofs
+            else np.zeros(0, np.int32)
+        )
+        self._bc_local = self._bc_local[self._bc_local < n_u]
+        self._bc_rows = (self._red0[comm.rank] + self._bc_local).astype(PETSc.IntType)
+        self._g = np.zeros(self.unknowns[0].x.array.size)
+        self.P: PETSc.Mat | None = None
+        self.A: PETSc.Mat | None = None
+        self._P_version = None
+        self.ksp = None
+        self._keep: tuple = ()
+        self.linear = linear or LinearSolverSettings()
+        self._refresh()
+        self._assemble_condensed_jacobian()
+        self.set_linear_solver(self.linear)
+        self.linear_solves = 0
+        self.residual_norm = np.inf
+        self.rebuilds = 0
+
+    # -- selection -------------------------------------------------------------
+    def _reduced_rows(self, blocks: np.ndarray) -> np.ndarray:
+        """Global reduced rows of component 0 of global V blocks."""
+        owner = np.searchsorted(self._vranges, blocks, side="right") - 1
+        return self._red0[owner] + (blocks - self._vranges[owner]) * self._bs
+
+    def _build_P(self) -> None:
+        """P: extended rows to reduced columns; identity on unknowns, S_k on extras."""
+        rank = self._comm.rank
+        cols = [self._red0[rank] + np.arange(self._n_red, dtype=np.int64)]
+        for src in self.transfer.sources():
+            base = self._reduced_rows(np.asarray(src, np.int64))
+            cols.append((base[:, None] + np.arange(self._bs)[None, :]).reshape(-1))
+        col = np.concatenate(cols).astype(PETSc.IntType)
+        assert col.size == self._n_ext
+        indptr = np.arange(self._n_ext + 1, dtype=PETSc.IntType)
+        if self.P is not None:
+            self.P.destroy()
+        self.P = PETSc.Mat().createAIJ(
+            size=((self._n_ext, self._N_ext), (self._n_red, self._N_red)),
+            csr=(indptr, col, np.ones(self._n_ext)),
+            comm=self._comm,
+        )
+        self.P.assemble()
+        self._P_version = self.transfer.version
+
+    def _refresh(self) -> None:
+        """Search and refill the target coefficients; new P when an assignment changed."""
+        with stopwatch(self.timings, "search_s"):
+            self.transfer.refresh()
+        if self._P_version != self.transfer.version:
+            with stopwatch(self.timings, "transfer_s"):
+                self._build_P()
+                if self.A is not None:
+                    self.A.destroy()
+                    self.A = None
+                self.rebuilds = getattr(self, "rebuilds", 0) + 1
+
+    # -- assembly ------------------------------------------------------------------
+    def _assemble_condensed_jacobian(self) -> None:
+        with stopwatch(self.timings, "jacobian_s"):
+            self.A_ext.zeroEntries()
+            fem_petsc.assemble_matrix(self.A_ext, self.J_ext, bcs=[], diag=1.0)
+            self.A_ext.assemble()
+        self.timings.jacobians += 1
+        with stopwatch(self.timings, "transfer_s"):
+            if self.A is None:
+                self.A = self.A_ext.PtAP(self.P)
+                self.A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+                if self.ksp is not None:
+                    self.set_linear_solver(self.linear)
+            else:
+                self.A_ext.PtAP(self.P, result=self.A)
+
+    def _boundary_values(self) -> None:
+        """Z = x - x_D on the Dirichlet rows, 0 elsewhere."""
+        self._g[:] = 0.0
+        fem.set_bc(self._g, self.bcs)
+        u = self.unknowns[0].x.array
+        self.z.zeroEntries()
+        z = self.z.getArray()
+        z[self._bc_local] = u[self._bc_local] - self._g[self._bc_local]
+
+    def assemble_residual(self) -> float:
+        """Search, assemble R_ext, condense, set Dirichlet rows; return the norm."""
+        self._refresh()
+        with stopwatch(self.timings, "residual_s"):
+            self._pull()
+            b = self.b_ext
+            with b.localForm() as local:
+                local.set(0.0)
+            fem_petsc.assemble_vector(b, self.F_ext)
+            b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        with stopwatch(self.timings, "transfer_s"):
+            self.P.multTranspose(b, self.b)
+            self._boundary_values()
+            arr = self.b.getArray()
+            arr[self._bc_local] = self.z.getArray(readonly=True)[self._bc_local]
+            self.residual_norm = float(self.b.norm())
+        self.timings.residuals += 1
+        return self.residual_norm
+
+    def newton_step(self, damping: float = 1.0) -> bool:
+        """Condensed Jacobian, Dirichlet elimination with lifting, solve, update."""
+        t = self.timings
+        self._assemble_condensed_jacobian()
+        with stopwatch(t, "transfer_s"):
+            self.A.zeroRowsColumns(self._bc_rows, 1.0, self.z, self.b)
+        try:
+            with stopwatch(t, "setup_s"):
+                self.ksp.setOperators(self.A)
+                self.ksp.setUp()
+                self.ksp.getPC().setUp()
+            with stopwatch(t, "solve_s"):
+                self.ksp.solve(self.b, self.dx)
+        except PETSc.Error:
+            return False
+        self.linear_solves += 1
+        t.linear_solves += 1
+        t.krylov_iterations += self.ksp.getIterationNumber() if self.linear.kind != "direct" else 0
+        if self.ksp.getConvergedReason() < 0:
+            return False
+        if not np.all(np.isfinite(self.dx.getArray(readonly=True))):
+            return False
+        self.x.axpy(-damping, self.dx)
+        self._push()
+        return True
+
+    def destroy(self) -> None:
+        """Free the PETSc objects."""
+        for obj in (self.ksp, self.A, self.A_ext, self.P, self.b, self.b_ext, self.x,
+                    self.dx, self.z):
+            if obj is not None:
+                obj.destroy()
+
+
+def kernel_for(
+    system: VariationalSystem, linear: LinearSolverSettings | None = None
+) -> NewtonKernel:
+    """The Newton kernel a system needs: condensing when it has extras."""
+    if system.extras:
+        return CondensedKernel(system, linear)
+    return NewtonKernel(system, linear)
+
+
+__all__ = ["CondensedKernel", "kernel_for"]

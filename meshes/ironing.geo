@@ -1,0 +1,35 @@
+// Ironing: a half-disk indenter (centre (0, R), flat face y = R, touching the
+// origin) above a block [-1, L - 1] x [-D, 0]. Same geometry and tags as
+// fenics_contact.scene.two_body_meshing.ironing.
+//
+// Physical groups:
+//   Surface "striker" = 1 (indenter), Surface "target" = 2 (block)    (cell tags)
+//   Curve "top" = 2, "striker_arc" = 3, "target_face" = 4, "bottom" = 5  (facet tags)
+
+DefineConstant[
+  R = {0.5, Name "Parameters/radius"},
+  L = {4.0, Name "Parameters/length"},
+  D = {1.0, Name "Parameters/depth"},
+  h_indenter = {0.04, Name "Parameters/h_indenter"},
+  h_block = {0.06, Name "Parameters/h_block"}
+];
+Geometry.AutoCoherence = 0;  // keep the two bodies apart
+
+Point(1) = {0, R, 0, 4 * h_indenter}; Point(2) = {-R, R, 0, 4 * h_indenter};
+Point(3) = {0, 0, 0, h_indenter}; Point(4) = {R, R, 0, 4 * h_indenter};
+Circle(1) = {2, 1, 3}; Circle(2) = {3, 1, 4}; Line(3) = {4, 2};
+Curve Loop(1) = {1, 2, 3}; Plane Surface(1) = {1};
+
+Point(11) = {-1, -D, 0, 4 * h_block}; Point(12) = {L - 1, -D, 0, 4 * h_block};
+Point(13) = {L - 1, 0, 0, h_block}; Point(14) = {-1, 0, 0, h_block};
+Line(11) = {11, 12}; Line(12) = {12, 13}; Line(13) = {13, 14}; Line(14) = {14, 11};
+Curve Loop(2) = {11, 12, 13, 14}; Plane Surface(2) = {2};
+
+Physical Surface("striker", 1) = {1};
+Physical Surface("target", 2) = {2};
+Physical Curve("top", 2) = {3};
+Physical Curve("striker_arc", 3) = {1, 2};
+Physical Curve("target_face", 4) = {13};
+Physical Curve("bottom", 5) = {11};
+Mesh.MeshSizeFromCurvature = 0;
+Mesh.Algorithm = 6;
