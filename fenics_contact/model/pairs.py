@@ -89,7 +89,7 @@ def _node_to_block(V: fem.FunctionSpace) -> np.ndarray:
     """Local block (vertex dof) of V at each local geometry node (P1 on a P1 mesh)."""
     geo = V.mesh.geometry
     out = np.full(geo.x.shape[0], -1, dtype=np.int64)
-    out[geo.dofmap.reshape(-1)] = V.dofmap.list.reshape(-1)
+    out[geo.dofmaps[0].reshape(-1)] = V.dofmap.list.reshape(-1)
     return out
 
 
@@ -139,7 +139,7 @@ class DeformablePair:
         f2c = topology.connectivity(fdim, tdim)
         cells = np.array([f2c.links(f)[0] for f in facets], np.int64)
         cell_centre = (
-            x[domain.geometry.dofmap[cells]].mean(axis=1) if facets.size else np.zeros((0, gdim))
+            x[domain.geometry.dofmaps[0][cells]].mean(axis=1) if facets.size else np.zeros((0, gdim))
         )
         X = x[nodes]
         normal = self._normals(X)

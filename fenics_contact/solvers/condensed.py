@@ -166,7 +166,8 @@ class CondensedKernel(NewtonKernel):
     def _boundary_values(self) -> None:
         """Z = x - x_D on the Dirichlet rows, 0 elsewhere."""
         self._g[:] = 0.0
-        fem.set_bc(self._g, self.bcs)
+        for bc in self.bcs:
+            bc.set(self._g)
         u = self.unknowns[0].x.array
         self.z.zeroEntries()
         z = self.z.getArray()
