@@ -14,6 +14,9 @@ def _run(args: argparse.Namespace) -> int:
 
     scene = load_scene(args.scene)  # validation first: no mesh, no forms yet
     out: Path = args.out or Path("results") / scene.name
+    from fenics_contact.output.folders import prepare_output_folder
+
+    prepare_output_folder(out, MPI.COMM_WORLD)  # a bad --out ends here, before any mesh
     from tqdm import tqdm
 
     from fenics_contact.runner import run_scene

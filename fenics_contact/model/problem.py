@@ -125,6 +125,20 @@ class ContactState:
     contact_force: float
 
 
+@dataclass(frozen=True)
+class DetFMinimum:
+    """Smallest det F = det(I + grad u) over the body's quadrature points.
+
+    Attributes:
+        value: the global minimum (1 undeformed, <= 0 inverted).
+        where: reference coordinates of the midpoint of the cell holding it
+            (length; 3 entries, z = 0 in 2D).
+    """
+
+    value: float
+    where: tuple[float, float, float]
+
+
 class ContactProblem:
     """One deformable body, one rigid obstacle, proportional loading."""
 
@@ -300,6 +314,39 @@ class ContactProblem:
         return (self.pressure - self.lam) * mu * self.surface.ds
 
     # -- diagnostics -----------------------------------------------------------
+    def min_det_F(self) -> DetFMinimum:
+        """Smallest det F over the body (quadrature points of degree 2, all ranks).
+
+        The points are those of a degree-2 rule on the cell, where the strain
+        energy is integrated; one compiled expression per problem.
+        """
+        if not hasattr(self, "_det_expr"):
+            import basix
+
+            cell = self.domain.basix_cell()
+            points, _ = basix.make_quadrature(cell, 2)
+            F = ufl.Identity(self.domain.geometry.dim) + ufl.grad(self.u)
+            self._det_expr = fem.Expression(ufl.det(F), points)
+            self._det_cells = np.arange(
+                self.domain.topology.index_map(self.domain.topology.dim).size_local,
+                dtype=np.int32,
+            )
+        values = self._det_expr.eval(self.domain, self._det_cells)
+        per_cell = values.reshape(self._det_cells.size, -1).min(axis=1)
+        if per_cell.size:
+            worst = int(np.argmin(per_cell))
+            local = float(per_cell[worst])
+            where = mesh.compute_midpoints(
+                self.domain, self.domain.topology.dim, self._det_cells[worst : worst + 1]
+            )[0]
+        else:
+            local, where = np.inf, np.zeros(3)
+        if not np.isfinite(local):
+            local = -np.inf if np.isnan(local) else local
+        value, rank = self.comm.allreduce((local, self.comm.rank), op=MPI.MINLOC)
+        where = self.comm.bcast(np.asarray(where, float), root=rank)
+        return DetFMinimum(float(value), (float(where[0]), float(where[1]), float(where[2])))
+
     def contact_state(self) -> ContactState:
         """Nodal gaps, pressures, the active set and global summaries."""
         gap = self.surface.nodal(self._gap_form)

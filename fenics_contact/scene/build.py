@@ -8,6 +8,7 @@ before any form is compiled.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -20,8 +21,13 @@ from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import material
 from fenics_contact.model.obstacles import RigidBall, RigidObstacle, RigidPlane
 from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement, SurfaceTraction
+from fenics_contact.model.rigid import free_rigid_motions
 from fenics_contact.scene.meshing import mesh_on_rank
 from fenics_contact.scene.schema import GENERATOR_TAGS, BoundarySpec, Scene, SceneError
+
+
+class SceneWarning(UserWarning):
+    """A scene that will run but probably not as meant (printed before the solve)."""
 
 
 @dataclass
@@ -189,12 +195,13 @@ def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProbl
         )
         for i, spec in enumerate(scene.tractions)
     ]
+    check_rigid_motions(scene, body, prescribed)
     obstacle = build_obstacle(scene, body.domain)
     settings = ContactSettings(
         r=scene.contact.r, relative=scene.contact.relative,
         quadrature=scene.contact.quadrature,  # type: ignore[arg-type]
     )
-    return ContactProblem(
+    problem = ContactProblem(
         body.domain,
         material(scene.law, scene.E, scene.nu),
         obstacle,
@@ -204,3 +211,47 @@ def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProbl
         tractions=tractions,
         obstacle_motion=scene.obstacle.motion,
     )
+    warn_initial_penetration(scene, problem)
+    return problem
+
+
+def check_rigid_motions(
+    scene: Scene, body: BodyMesh, prescribed: list[PrescribedDisplacement]
+) -> None:
+    """Raise SceneError naming the rigid motions no Dirichlet condition holds.
+
+    Contact and tractions do not count: before contact is made they hold
+    nothing and the stiffness is singular.
+    """
+    free = free_rigid_motions(body.domain, [(p.facets, p.value) for p in prescribed])
+    if free:
+        raise SceneError(
+            f"{scene.path.name}: the [[dirichlet]] conditions leave rigid motions of the body "
+            f"free ({'; '.join(free)}); contact does not hold them. Fix: prescribe more "
+            "components or facets (e.g. value = [0.0, 0.0] on a side, or a second side)."
+        )
+
+
+def initial_penetration(problem: ContactProblem) -> float:
+    """Largest penetration of the contact nodes into the obstacle at load factor 0 (length)."""
+    points = problem.nodal_coordinates()[:, : problem.domain.geometry.dim]
+    gap = problem.obstacle.gap_value(points) if points.size else np.zeros(0)
+    local = float(np.max(-np.minimum(gap, 0.0), initial=0.0))
+    return float(problem.comm.allreduce(local, op=MPI.MAX))
+
+
+def warn_initial_penetration(scene: Scene, problem: ContactProblem) -> float:
+    """Warn (SceneWarning) when the body starts inside the obstacle by more than h."""
+    depth = initial_penetration(problem)
+    h = problem.surface.h
+    if depth > h:
+        warnings.warn(
+            SceneWarning(
+                f"{scene.path.name}: the body starts {depth:.4g} inside the obstacle, more "
+                f"than the contact facet size h = {h:.4g} ({depth / h:.3g} h); expect squashed "
+                "or inverted elements. Move [obstacle] point/centre so the gap at load 0 is "
+                ">= 0, and let [obstacle] motion or [[dirichlet]] values bring contact."
+            ),
+            stacklevel=2,
+        )
+    return depth

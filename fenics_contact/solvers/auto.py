@@ -40,7 +40,12 @@ from dolfinx.fem import petsc as fem_petsc
 from fenics_contact.model.problem import ContactProblem
 from fenics_contact.model.scaling import residual_floor
 from fenics_contact.solvers.base import SolveResult, newton_loop, timed
-from fenics_contact.solvers.diagnostics import ConvergenceMonitor, SolverSettings, Status
+from fenics_contact.solvers.diagnostics import (
+    ConvergenceMonitor,
+    SolverSettings,
+    Status,
+    signorini_admissibility,
+)
 from fenics_contact.solvers.newton import NewtonKernel
 
 
@@ -200,7 +205,9 @@ class AutoStrategy:
 
     def _newton(self, settings: SolverSettings, tally: _Tally, *, line_search: bool) -> Status:
         """Newton on the Alart-Curnier system, plain or with backtracking."""
-        monitor = ConvergenceMonitor(settings)
+        monitor = ConvergenceMonitor(
+            settings, admissible=signorini_admissibility(self.problem, settings)
+        )
         if line_search:
             status, steps = self._line_search_loop(self.kernel, monitor)
         else:

@@ -8,7 +8,12 @@ from dataclasses import dataclass, field
 from typing import Protocol
 
 from fenics_contact.model.problem import ContactProblem, VariationalSystem
-from fenics_contact.solvers.diagnostics import ConvergenceMonitor, SolverSettings, Status
+from fenics_contact.solvers.diagnostics import (
+    ConvergenceMonitor,
+    SolverSettings,
+    Status,
+    signorini_admissibility,
+)
 from fenics_contact.solvers.newton import NewtonKernel
 
 
@@ -102,12 +107,20 @@ class MonolithicNewton:
         """The residual blocks this strategy solves."""
         raise NotImplementedError
 
+    #: Whether convergence also needs the Signorini conditions in their own
+    #: units (False for the penalty method, whose penetration is its regularisation).
+    exact_constraint = True
+
     def solve(self) -> SolveResult:
         """Newton until the system's residual norm passes the stopping test."""
         return timed(self._solve)
 
     def _solve(self) -> SolveResult:
-        monitor = ConvergenceMonitor(self.settings, observer=self.observer)
+        monitor = ConvergenceMonitor(
+            self.settings, observer=self.observer,
+            admissible=signorini_admissibility(self.problem, self.settings)
+            if self.exact_constraint else None,
+        )
         before = self.kernel.linear_solves
         status, steps = newton_loop(
             self.kernel, monitor, self.kernel.assemble_residual, self.problem.active_signature

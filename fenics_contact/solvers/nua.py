@@ -13,7 +13,12 @@ from dataclasses import dataclass
 
 from fenics_contact.model.problem import ContactProblem
 from fenics_contact.solvers.base import SolveResult, timed
-from fenics_contact.solvers.diagnostics import ConvergenceMonitor, SolverSettings, Status
+from fenics_contact.solvers.diagnostics import (
+    ConvergenceMonitor,
+    SolverSettings,
+    Status,
+    signorini_admissibility,
+)
 from fenics_contact.solvers.uzawa import UzawaBase
 
 
@@ -43,7 +48,10 @@ class NestedUzawa(UzawaBase):
         return timed(self._solve)
 
     def _solve(self) -> SolveResult:
-        monitor = ConvergenceMonitor(self.settings, observer=self.observer)
+        monitor = ConvergenceMonitor(
+            self.settings, observer=self.observer,
+            admissible=signorini_admissibility(self.problem, self.settings),
+        )
         before = self.kernel.linear_solves
         steps = updates = 0
         fresh = True  # a Newton step was taken since the last update

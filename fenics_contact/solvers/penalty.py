@@ -14,6 +14,7 @@ class Penalty(MonolithicNewton):
     """Newton on Pi + r/2 int min(g, 0)^2; the multiplier stays zero."""
 
     name = "penalty"
+    exact_constraint = False
 
     def build_system(self, problem: ContactProblem) -> VariationalSystem:
         """The penalised equilibrium; zeroing lam makes diagnostics report r min(g, 0)."""

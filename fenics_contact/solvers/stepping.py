@@ -5,6 +5,11 @@ undone (displacement and multiplier restored) and retried with half the
 increment, up to ``max_cutbacks`` times in a row; past that the path stops
 with the failing status, and the steps already converged are kept (the
 ``on_step`` callback has written them).
+
+A converged solve is accepted only when det F > 0 at every quadrature point
+of the body (:meth:`ContactProblem.min_det_F`); otherwise the attempt counts
+as failed with status ``inverted`` and is cut back like any other failure.
+A path that ends ``inverted`` names the worst cell in ``StepRecord.message``.
 """
 
 from __future__ import annotations
@@ -34,6 +39,10 @@ class StepRecord:
         max_penetration: largest nodal penetration (length).
         contact_force: total normal contact force (force, per thickness in 2D).
         wall_s: wall-clock time of the step (seconds).
+        min_det_F: smallest det F over the body at the end of the step (1
+            undeformed; <= 0 means inverted elements).
+        worst_cell: reference midpoint of the cell holding ``min_det_F``.
+        message: why the step failed (empty when it converged).
     """
 
     step: int
@@ -48,6 +57,9 @@ class StepRecord:
     max_penetration: float = 0.0
     contact_force: float = 0.0
     wall_s: float = 0.0
+    min_det_F: float = 1.0
+    worst_cell: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    message: str = ""
 
     def to_dict(self) -> dict:
         """Plain-data view for JSON."""
@@ -89,6 +101,20 @@ def _absorb(record: StepRecord, result: SolveResult) -> None:
     record.residuals.append(result.residuals)
 
 
+def _failure_message(record: StepRecord, t_try: float) -> str:
+    if record.status == Status.INVERTED:
+        x = ", ".join(f"{c:.4g}" for c in record.worst_cell)
+        return (
+            f"elements inverted (det F = {record.min_det_F:.3g} <= 0) near ({x}) at load "
+            f"factor {t_try:.4g}, even with the increment halved {record.cutbacks - 1} times; "
+            "reduce the load, its initial penetration or r, or refine the mesh there"
+        )
+    return (
+        f"{record.status} at load factor {t_try:.4g} with the increment halved "
+        f"{record.cutbacks - 1} times"
+    )
+
+
 def solve_load_path(
     strategy: Strategy,
     n_steps: int,
@@ -121,18 +147,24 @@ def solve_load_path(
             _absorb(record, result)
             if on_iteration is not None:
                 on_iteration(record, result)
+            status = result.status
             if result.converged:
-                t = t_try
-                halvings = 0
-                continue
+                det = problem.min_det_F()
+                record.min_det_F, record.worst_cell = det.value, det.where
+                if det.value > 0.0:
+                    t = t_try
+                    halvings = 0
+                    continue
+                status = Status.INVERTED
             problem.u.x.array[:] = saved[0]
             problem.lam.x.array[:] = saved[1]
             problem.set_load(t)
             record.cutbacks += 1
             halvings += 1
             if halvings > max_cutbacks:
-                record.status = result.status.value
+                record.status = status.value
                 record.load_factor = t
+                record.message = _failure_message(record, t_try)
                 break
             increment /= 2
         record.wall_s = time.perf_counter() - start

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from fenics_contact.solvers.base import SolveResult, newton_loop, timed
-from fenics_contact.solvers.diagnostics import ConvergenceMonitor
+from fenics_contact.solvers.diagnostics import ConvergenceMonitor, signorini_admissibility
 from fenics_contact.solvers.uzawa import UzawaBase
 
 
@@ -17,7 +17,10 @@ class SimultaneousUzawa(UzawaBase):
         return timed(self._solve)
 
     def _solve(self) -> SolveResult:
-        monitor = ConvergenceMonitor(self.settings, observer=self.observer)
+        monitor = ConvergenceMonitor(
+            self.settings, observer=self.observer,
+            admissible=signorini_admissibility(self.problem, self.settings),
+        )
         before = self.kernel.linear_solves
         status, steps = newton_loop(
             self.kernel,
