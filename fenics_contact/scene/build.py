@@ -76,33 +76,71 @@ def _open(gmsh: Any, scene: Scene) -> None:
     gmsh.open(str(scene.mesh.file))
 
 
-def _physical_dimensions(scene: Scene, comm: MPI.Comm) -> set[int]:
-    """Dimensions of the file's physical groups (read on rank 0, known to all)."""
+def _physical_groups(scene: Scene, comm: MPI.Comm) -> dict[tuple[int, int], str]:
+    """The file's physical groups, {(dim, tag): name}, read on rank 0, known to all.
+
+    A file gmsh cannot read raises SceneError (on every rank) naming it.
+    """
     import gmsh
 
-    dims: set[int] = set()
+    groups: dict[tuple[int, int], str] = {}
+    problem: str | None = None
     if comm.rank == 0:
         started = not gmsh.isInitialized()
         if started:
             gmsh.initialize(interruptible=False)
         try:
             _open(gmsh, scene)
-            dims = {d for d, _ in gmsh.model.getPhysicalGroups()}
+            for d, t in gmsh.model.getPhysicalGroups():
+                groups[(d, t)] = gmsh.model.getPhysicalName(d, t)
+        except Exception as exc:  # gmsh raises bare Exception
+            message = " ".join(str(exc).split()) or type(exc).__name__
+            problem = (
+                f"{scene.path.name}: [mesh] file = {str(scene.mesh.file)!r}: gmsh cannot read "
+                f"it ({message}); check that it is a complete .geo/.msh file."
+            )
         finally:
             gmsh.finalize() if started else gmsh.model.remove()
-    return comm.bcast(dims, root=0)
+    groups, problem = comm.bcast((groups, problem), root=0)
+    if problem is not None:
+        raise SceneError(problem)
+    return groups
+
+
+def _check_tags(scene: Scene, groups: dict[tuple[int, int], str]) -> None:
+    """Every tag the scene names must be a facet physical group of the file."""
+    fdim = scene.dimension - 1
+    names = {name: tag for (d, tag), name in groups.items() if d == fdim and name}
+    numbers = {tag for (d, tag) in groups if d == fdim}
+    uses = [(f"dirichlet {i + 1}", b.tag) for i, b in enumerate(scene.dirichlet)]
+    uses += [(f"traction {i + 1}", b.tag) for i, b in enumerate(scene.tractions)]
+    if scene.contact.tag is not None:
+        uses.append(("contact", scene.contact.tag))
+    listing = ", ".join(
+        (f"{n} = {t}" if n else str(t))
+        for t, n in sorted((t, groups[(fdim, t)]) for t in numbers)
+    )
+    for section, tag in uses:
+        known = tag in names if isinstance(tag, str) else tag in numbers
+        if not known:
+            raise SceneError(
+                f"{scene.path.name}: [{section}] tag = {tag!r} is not a {fdim}D physical group "
+                f"of {scene.mesh.file.name}; available: {listing or 'none'}."
+            )
 
 
 def _from_gmsh(scene: Scene, comm: MPI.Comm) -> BodyMesh:
     spec = scene.mesh
     assert spec.file is not None
-    dims = _physical_dimensions(scene, comm)
+    groups = _physical_groups(scene, comm)
+    dims = {d for d, _ in groups}
     if scene.dimension not in dims:
         raise SceneError(
             f"{scene.path.name}: [scene] dimension = {scene.dimension}, but the mesh "
             f"{spec.file.name} has no {scene.dimension}D physical group; set the "
             "dimension to the mesh's or add a physical group for the body."
         )
+    _check_tags(scene, groups)  # before meshing: the file names its groups
 
     def build(gmsh: Any) -> None:
         _open(gmsh, scene)
