@@ -2,7 +2,9 @@
 
 The load factor goes from 0 to 1 in equal increments. A failed increment is
 undone (displacement and multiplier restored) and retried with half the
-increment, up to ``max_cutbacks`` times in a row; past that the path stops
+increment, up to ``max_cutbacks`` times in a row, and never below the step's
+increment / 2**max_cutbacks (a limit the load cannot pass, such as inverted
+elements at a fixed load, would otherwise halve it forever); past that the path stops
 with the failing status, and the steps already converged are kept (the
 ``on_step`` callback has written them).
 
@@ -139,6 +141,7 @@ def solve_load_path(
         start = time.perf_counter()
         increment = target - t
         halvings = 0
+        smallest = increment / 2**max_cutbacks
         while t < target - 1e-14:
             t_try = min(t + increment, target)
             saved = (problem.u.x.array.copy(), problem.lam.x.array.copy())
@@ -161,7 +164,7 @@ def solve_load_path(
             problem.set_load(t)
             record.cutbacks += 1
             halvings += 1
-            if halvings > max_cutbacks:
+            if halvings > max_cutbacks or increment / 2 < smallest * (1 - 1e-12):
                 record.status = status.value
                 record.load_factor = t
                 record.message = _failure_message(record, t_try)
