@@ -113,7 +113,11 @@ class ContactState:
         active_count: global number of nodes with lam + r g < 0.
         max_penetration: global max of -min(g, 0) (length).
         contact_force: global normal force -int p dA on the reference surface
-            (force; per unit thickness in 2D).
+            (force; per unit thickness in 2D). Multiplier strategies report
+            -int lam dA: at convergence lam = p, and lam does not carry the
+            round-off of r g that p carries at huge r (at r = 1e12 E/h a gap
+            of 1e-15 makes r g of order one). The penalty method, whose
+            multiplier is zero, reports -int r min(g, 0) dA.
     """
 
     gap: np.ndarray
@@ -203,6 +207,12 @@ class ContactProblem:
         self._force_form = fem.form(
             -self.pressure * self.surface.ds, entity_maps=self.surface.entity_maps
         )
+        self._multiplier_force_form = fem.form(
+            -self.lam * self.surface.ds, entity_maps=self.surface.entity_maps
+        )
+        #: Whether lam is the contact pressure of the solution (False for the
+        #: penalty method, which sets it): chooses the contact-force formula.
+        self.multiplier_is_pressure = True
 
     # -- parameters and loads -------------------------------------------------
     @property
@@ -365,7 +375,10 @@ class ContactProblem:
                 float(np.max(-np.minimum(gap, 0.0), initial=0.0)) + 0.0, op=MPI.MAX
             ),
             contact_force=comm.allreduce(
-                fem.assemble_scalar(self._force_form), op=MPI.SUM
+                fem.assemble_scalar(
+                    self._multiplier_force_form if self.multiplier_is_pressure
+                    else self._force_form
+                ), op=MPI.SUM
             ),
         )
 

@@ -33,15 +33,16 @@ from fenics_contact.model.scaling import DEFAULT_FORCE_RTOL, scaled_atol
 from fenics_contact.output.io import write_json
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.base import SolveResult
-from fenics_contact.solvers.diagnostics import SolverSettings
+from fenics_contact.solvers.diagnostics import SolverSettings, Status
 from fenics_contact.solvers.stepping import StepRecord, solve_load_path
 from fenics_contact.verification.bench_scenes import BarScene, BlockScene, HertzScene
 
 #: Methods the stability grid runs by default.
 METHODS = ("penalty", "sua", "nua", "gnrm", "auto")
 
-#: Extra statuses of a run besides the solver statuses.
-ERROR = "error"
+#: Extra statuses of a run besides the solver statuses: an exception (with
+#: its message in ``CaseRecord.message``) and non-finite outputs.
+ERROR = Status.ERROR.value
 NONFINITE = "nonfinite"
 
 
@@ -127,6 +128,10 @@ class CaseRecord:
     switches: int = 0
     switch_log: list[str] = field(default_factory=list)
     message: str = ""
+    #: Root mean square of the nodal displacement components (length): a
+    #: displacement measure to compare with a reference (max |u| is often
+    #: the prescribed value).
+    u_rms: float = 0.0
 
     def row(self) -> dict[str, object]:
         """Flat CSV row (the switch log shortened to its distinct kinds)."""
@@ -182,6 +187,10 @@ def run_case(
         state = problem.contact_state()
         local_u = float(np.max(np.abs(problem.u.x.array), initial=0.0))
         record.max_abs_u = comm.allreduce(local_u, op=MPI.MAX)
+        n_owned = problem.V.dofmap.index_map.size_local * problem.V.dofmap.index_map_bs
+        owned = problem.u.x.array[:n_owned]
+        total = comm.allreduce(float(np.dot(owned, owned)), op=MPI.SUM)
+        record.u_rms = math.sqrt(total / max(comm.allreduce(n_owned, op=MPI.SUM), 1))
         record.status = path.status
         record.iterations = path.iterations
         record.linear_solves = path.linear_solves
@@ -191,9 +200,11 @@ def run_case(
         record.max_penetration = state.max_penetration
         record.contact_force = state.contact_force
         record.switches = len(record.switch_log)
-        if not _finite(record.max_abs_u, state.max_penetration, state.contact_force):
+        if not _finite(record.max_abs_u, record.u_rms, state.max_penetration,
+                       state.contact_force):
             record.status = NONFINITE
             record.max_abs_u = record.max_penetration = record.contact_force = 0.0
+            record.u_rms = 0.0
     except Exception as exc:
         record.status = ERROR
         record.message = f"{type(exc).__name__}: {exc}".splitlines()[0][:200]
