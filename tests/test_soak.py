@@ -3,8 +3,8 @@
 Property: for any scene within the documented ranges (r, E, nu, law, mesh,
 load steps, obstacle placement, method), a run raises no exception, ends with
 a status of the documented set, writes every finished step to disk, and no
-output holds NaN or inf; a converged run of a multiplier method meets the
-Signorini conditions in their own units and no accepted step has det F <= 0.
+output holds NaN or inf; a converged run of a multiplier method with the nodal
+rule meets the Signorini conditions in their own units and no accepted step has det F <= 0.
 
 Profiles (environment variable HYPOTHESIS_PROFILE): ``ci`` (default: a few
 derandomized examples, no deadline) and ``soak`` (many; ``make soak``).
@@ -145,7 +145,8 @@ def check_run(scene: dict) -> None:
                 f.visititems(finite)
         # accepted steps are not inverted; converged multiplier methods meet Signorini
         assert all(s["min_det_F"] > 0 for s in steps if s["status"] == "converged")
-        if summary["status"] == "converged" and scene["solver"]["method"] != "penalty":
+        exact = scene["solver"]["method"] != "penalty" and scene["contact"]["quadrature"] == "nodal"
+        if summary["status"] == "converged" and exact:
             h = outcome.problem.surface.h
             assert steps[-1]["max_penetration"] <= 1e-6 * h + 1e-14
 
