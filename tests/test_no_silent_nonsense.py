@@ -1,6 +1,7 @@
 """No silent nonsense: inverted elements refuse a step, convergence means Signorini holds."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -153,3 +154,31 @@ def test_min_det_F_is_in_summary(tmp_path):
     steps = json.loads((tmp_path / "out" / "summary.json").read_text())["steps"]
     dets = [s["min_det_F"] for s in steps]
     assert 0.8 < dets[1] < dets[0] < 1.0  # compressed by 10 %, more at the second step
+
+
+def test_cli_run_that_would_invert_elements_stops_and_says_where(tmp_path, capsys):
+    """Small-strain law, top pushed down by 1.2 heights: converges to inverted cells."""
+    from fenics_contact.cli import main
+
+    scene = tmp_path / "inv.toml"
+    scene.write_text(
+        '[scene]\nname = "inv"\ndimension = 2\n[mesh]\ngenerator = "rectangle"\n'
+        "size = [1.0, 0.5]\ncells = [4, 2]\n[material]\nlaw = \"linear\"\nE = 210.0\n"
+        'nu = 0.3\n[[dirichlet]]\ntag = "top"\nvalue = ["free", -0.6]\n[[dirichlet]]\n'
+        'tag = "left"\nvalue = [0.0, "free"]\n[obstacle]\ntype = "plane"\n'
+        'point = [0.0, 0.0]\nnormal = [0.0, 1.0]\n[contact]\ntag = "bottom"\n[solver]\n'
+        "steps = 4\n[output]\npictures = false\n"
+    )
+    out = tmp_path / "out"
+    assert main(["run", str(scene), "--out", str(out), "--quiet"]) == 1
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert "load step 4 of 4 did not converge (inverted" in err
+    assert re.search(r"det F = -?[0-9.e-]+ <= 0\) near \([0-9.]+, [0-9.]+, 0\)", err), err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "inverted" and summary["steps_completed"] == 3
+    steps = summary["steps"]
+    # uniform compression: det F = (1 + nu/(1-nu) e)(1 - e) with e = 0.3 ... 0.9 per step
+    for step, e in zip(steps[:3], (0.3, 0.6, 0.9), strict=True):
+        assert step["min_det_F"] == pytest.approx((1 + 0.3 / 0.7 * e) * (1 - e), rel=1e-6)
+    assert steps[3]["min_det_F"] <= 0.0

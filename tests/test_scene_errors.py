@@ -320,6 +320,7 @@ def test_dirichlet_bounds_selecting_nothing(tmp_path):
         _build(write(tmp_path, scene))
 
 
+@pytest.mark.mpi
 @pytest.mark.parametrize(
     ("dirichlet", "free"),
     [
@@ -340,6 +341,7 @@ def test_rigid_motions_left_free_are_named(tmp_path, dirichlet, free):
         _build(write(tmp_path, scene))
 
 
+@pytest.mark.mpi
 def test_free_rigid_motions_3d_and_pin():
     from dolfinx import mesh
 

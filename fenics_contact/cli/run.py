@@ -46,8 +46,9 @@ def _run(args: argparse.Namespace) -> int:
         done = len(path.steps) - 1
         print(
             f"fenics-contact: load step {failed.step} of {scene.solver.steps} did not converge "
-            f"({failed.status} after {failed.cutbacks} cut-backs); steps 1-{done} are in "
-            f"{out}/solution.xdmf",
+            f"({failed.status} after {failed.cutbacks} cut-backs"
+            + (f": {failed.message}" if failed.message else "")
+            + f"); steps 1-{done} are in {out}/solution.xdmf",
             file=sys.stderr,
         )
         return 1
