@@ -70,8 +70,10 @@ def free_rigid_motions(
     tdim = domain.topology.dim
     comm = domain.comm
     x = domain.geometry.x[:, :gdim]
-    lo = comm.allreduce(x.min(axis=0) if x.size else np.full(gdim, np.inf), op=MPI.MIN)
-    hi = comm.allreduce(x.max(axis=0) if x.size else np.full(gdim, -np.inf), op=MPI.MAX)
+    lo = np.empty(gdim)
+    hi = np.empty(gdim)
+    comm.Allreduce(x.min(axis=0) if x.size else np.full(gdim, np.inf), lo, op=MPI.MIN)
+    comm.Allreduce(x.max(axis=0) if x.size else np.full(gdim, -np.inf), hi, op=MPI.MAX)
     centre = 0.5 * (lo + hi)
     size = float(np.max(hi - lo)) or 1.0
     n_modes = 3 if gdim == 2 else 6
@@ -88,7 +90,9 @@ def free_rigid_motions(
                 continue
             rows = _basis(points, component, gdim)
             gram += rows.T @ rows
-    gram = comm.allreduce(gram, op=MPI.SUM)
+    total = np.empty_like(gram)
+    comm.Allreduce(gram, total, op=MPI.SUM)
+    gram = total
     eigenvalues, vectors = np.linalg.eigh(gram)
     scale = max(float(eigenvalues.max()), 1.0)
     null = vectors[:, eigenvalues <= 1e-10 * scale]
