@@ -182,3 +182,25 @@ def test_cli_run_that_would_invert_elements_stops_and_says_where(tmp_path, capsy
     for step, e in zip(steps[:3], (0.3, 0.6, 0.9), strict=True):
         assert step["min_det_F"] == pytest.approx((1 + 0.3 / 0.7 * e) * (1 - e), rel=1e-6)
     assert steps[3]["min_det_F"] <= 0.0
+
+
+@pytest.mark.mpi
+def test_signorini_test_names_penetration_and_tension_in_their_units():
+    from fenics_contact.solvers.diagnostics import signorini_admissibility
+
+    problem = square_problem()  # h = 0.25, E = 210
+    check = signorini_admissibility(problem, SolverSettings(gap_tol=1e-6, tension_tol=1e-6))
+    assert check() is None
+    problem.u.interpolate(lambda x: np.vstack([0 * x[0], -1e-6 + 0 * x[1]]))  # 4e-6 h inside
+    assert check().startswith("penetration 1e-06 > gap_tol * h = 1e-06 * 0.25")
+    problem.u.interpolate(lambda x: np.vstack([0 * x[0], -1e-8 + 0 * x[1]]))  # 4e-8 h: fine
+    assert check() is None
+    problem.lam.x.array[:] = 1e-3  # tension 1e-3 > 1e-6 * 210
+    assert check().startswith("tension 0.001 > tension_tol * E = 1e-06 * 210")
+    problem.lam.x.array[:] = 1e-4  # below 2.1e-4
+    assert check() is None
+    gauss = ContactProblem(
+        problem.domain, problem.material, problem.obstacle, problem.surface.facets,
+        ContactSettings(r=1.0, quadrature="gauss"),
+    )
+    assert signorini_admissibility(gauss, SolverSettings()) is None

@@ -165,6 +165,17 @@ def test_scene_file_missing_directory_toml_and_binary(tmp_path):
         load_scene(binary)
 
 
+def test_unreadable_scene_file(tmp_path, monkeypatch):
+    path = write(tmp_path, base())
+
+    def refuse(self, *args, **kwargs):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(Path, "read_text", refuse)
+    with pytest.raises(SceneError, match=r"scene.toml cannot be read \(Permission denied\)"):
+        load_scene(path)
+
+
 # -- mesh files ----------------------------------------------------------------------
 def _file_scene(tmp_path, name, content: bytes | None, **extra):
     if content is not None:
