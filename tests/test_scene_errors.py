@@ -246,6 +246,14 @@ def test_corrupt_mesh_exits_2_with_one_line(tmp_path, capsys, how):
     assert not out.exists()
 
 
+def test_geo_with_a_syntax_error_exits_2(tmp_path, capsys):
+    path = _file_scene(tmp_path, "broken.geo", b"Point(1) = {0, 0, 0;\nnot geo\n")
+    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1, err
+    assert re.search(r"broken.geo.*gmsh cannot read it \(.*line 1: syntax error", err), err
+
+
 # -- building (needs the mesh, still before any form) ----------------------------------
 def _build(path):
     from fenics_contact.scene.build import build_problem
