@@ -20,7 +20,7 @@ from pathlib import Path
 
 import h5py
 import numpy as np
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from fenics_contact.scene.schema import METHODS, load_scene
@@ -119,6 +119,7 @@ def check_run(scene: dict) -> None:
             warnings.simplefilter("ignore")  # e.g. the initial-penetration warning
             outcome = run_scene(load_scene(path), out, pictures=False)
         summary = json.loads((out / "summary.json").read_text())
+        event(f"status {summary['status']}")  # shown by --hypothesis-show-statistics
         assert summary["status"] in STATUSES
         assert summary["status"] == outcome.path.status
         steps = summary["steps"]
