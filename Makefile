@@ -35,7 +35,8 @@ test-mpi: venv
 # few derandomized ones in `make test`); SOAK_EXAMPLES sets how many.
 SOAK_EXAMPLES ?= 200
 soak: venv
-	HYPOTHESIS_PROFILE=soak SOAK_EXAMPLES=$(SOAK_EXAMPLES) $(BIN)/python -m pytest -q tests/test_soak.py
+	HYPOTHESIS_PROFILE=soak SOAK_EXAMPLES=$(SOAK_EXAMPLES) $(BIN)/python -m pytest -q \
+	    --hypothesis-show-statistics tests/test_soak.py
 
 # .msh files from every meshes/*.geo (physical groups kept).
 meshes: venv
