@@ -7,7 +7,7 @@ BIN     := $(VENV)/bin
 MPIEXEC ?= $(shell [ -x $(BIN)/mpiexec ] && echo $(BIN)/mpiexec || echo mpiexec)
 OUT     ?= results
 
-.PHONY: demo test test-serial test-mpi venv meshes lint clean paper-tables paper-ex1-geometry
+.PHONY: demo test test-serial test-mpi soak venv meshes lint clean paper-tables paper-ex1-geometry
 
 venv: $(VENV)/.installed
 
@@ -30,6 +30,13 @@ test-serial: venv
 # Tests marked `mpi` again on two processes.
 test-mpi: venv
 	$(MPIEXEC) -n 2 $(BIN)/python -m pytest -q -m mpi -p no:cacheprovider
+
+# The property-based soak with many random scenes (tests/test_soak.py runs a
+# few derandomized ones in `make test`); SOAK_EXAMPLES sets how many.
+SOAK_EXAMPLES ?= 200
+soak: venv
+	HYPOTHESIS_PROFILE=soak SOAK_EXAMPLES=$(SOAK_EXAMPLES) $(BIN)/python -m pytest -q \
+	    --hypothesis-show-statistics tests/test_soak.py
 
 # .msh files from every meshes/*.geo (physical groups kept).
 meshes: venv

@@ -91,6 +91,9 @@ def one(args: argparse.Namespace) -> None:
 def table(out: Path) -> None:
     """Gather the per-case JSON files into ladder3d.md."""
     cases = [json.loads(p.read_text())["median"] for p in sorted((out / "ladder3d").glob("*.json"))]
+    if not cases:
+        print(f"No ladder cases in {out / 'ladder3d'}; run ladder3d.py --dofs N first.")
+        return
     cases.sort(key=lambda m: (m["solver"], m["ranks"], m["u_dofs"]))
     rows = [
         (m["u_dofs"], m["lam_dofs"], m["solver"], m["ranks"], m["repeats"], m["newton_total"],

@@ -1,7 +1,16 @@
-"""Every extreme of the stability grid ends with a status and finite outputs."""
+"""Every extreme of the stability grid ends with a status, finite outputs and the right answer.
+
+The answers are references, not the run's own numbers: with the nodal rule the
+discrete solution does not depend on r, and for a hyperelastic frictionless
+contact the state at load factor 1 does not depend on the load path, so an
+extreme of r or of the number of steps must give the contact force and the
+displacement of plain GNRM at r = 1 E/h with 10 steps. A crash (status
+``error``) fails every test that meets it, with its message.
+"""
 
 import json
 import math
+from dataclasses import replace
 
 import pytest
 
@@ -24,8 +33,27 @@ def finite(record):
 
 def run(name, method="auto", **options):
     record = run_case(CASES[name], method, **options)
+    assert record.status != ERROR, f"{name} {method} crashed: {record.message}"
     assert finite(record), record
     return record
+
+
+#: The reference of each extreme: GNRM at r = 1 on this case (r extremes: the
+#: r = 1 case; step-count extremes: the 10-step case).
+REFERENCE = {
+    "bar-r1e-8": "bar-r1e0", "bar-r1e12": "bar-r1e0", "hertz-r1e12": "hertz-r1e0",
+    "bar-steps1": "bar-r1e0", "bar-steps100": "bar-r1e0",
+}
+_references: dict = {}
+
+
+def reference(name):
+    key = REFERENCE.get(name, name)
+    if key not in _references:
+        record = run_case(replace(CASES[key], r=1.0), "gnrm")
+        assert record.status == "converged", record
+        _references[key] = record
+    return _references[key]
 
 
 @pytest.mark.parametrize(
@@ -38,6 +66,17 @@ def test_auto_converges_at_the_extreme(name):
     assert record.status == "converged", record
     assert record.steps_completed == record.load_steps
     assert record.max_penetration < 1e-9
+    ref = reference(name)
+    assert record.contact_force == pytest.approx(ref.contact_force, rel=1e-8)
+    assert record.u_rms == pytest.approx(ref.u_rms, rel=1e-8)
+    assert record.u_rms > 0.1 * record.max_abs_u  # a displacement field, not zeros
+
+
+def test_reference_answers_are_the_known_ones():
+    """Pin the references themselves, so that a change of all answers shows."""
+    assert reference("bar-r1e0").contact_force == pytest.approx(119.025678295, rel=1e-8)
+    # Hertz line contact on this mesh: P = 1.0642 against the analytic 1.064 (push 0.01)
+    assert reference("hertz-r1e0").contact_force == pytest.approx(1.06422645717, rel=1e-8)
 
 
 def test_forces_scale_with_E_and_the_stopping_test_with_them():
@@ -46,22 +85,35 @@ def test_forces_scale_with_E_and_the_stopping_test_with_them():
     assert low.status == high.status == "converged"
     assert low.iterations == high.iterations
     assert low.contact_force / low.E == pytest.approx(high.contact_force / high.E, rel=1e-9)
+    # displacement loading: the same displacements, forces E / 210 times the E = 210 bar's
+    ref = reference("bar-r1e0")
+    assert high.u_rms == pytest.approx(ref.u_rms, rel=1e-8)
+    assert high.contact_force / high.E == pytest.approx(ref.contact_force / ref.E, rel=1e-8)
     assert high.atol / low.atol == pytest.approx(1e15)
 
 
 def test_initial_penetration_is_pushed_out():
     record = run("bar-penetrating")
     assert record.status == "converged" and record.max_penetration < 1e-12
+    ref = reference("bar-penetrating")
+    assert record.contact_force == pytest.approx(ref.contact_force, rel=1e-8)
+    # pushed 0.02 further than the 10-step bar: a larger force, not the same one
+    assert record.contact_force > 1.002 * reference("bar-r1e0").contact_force
 
 
 def test_no_contact_and_full_contact():
     free = run("bar-no-contact", method="gnrm")
     assert free.status == "converged" and free.contact_force == 0.0
+    assert free.max_penetration == 0.0 and free.u_rms > 0.0
     full = run("block-full-contact")
     scene = CASES["block-full-contact"].scene
     assert full.status == "converged"
-    # uniaxial compression of a unit block: force ~ E' delta (finite strain within 10 %)
-    assert full.contact_force == pytest.approx(scene.E / (1 - scene.nu**2) * scene.delta, rel=0.1)
+    # homogeneous uniaxial plane-strain compression of a unit SVK block (stretch
+    # l = 1 - delta, lateral faces free): first Piola stress E' l (l^2 - 1) / 2 with
+    # E' = E / (1 - nu^2). 10.6875 here; E' delta = 11.54 and E delta = 10.5 both fail.
+    stretch = 1.0 - scene.delta
+    exact = scene.E / (1 - scene.nu**2) * stretch * (1 - stretch**2) / 2
+    assert full.contact_force == pytest.approx(exact, rel=1e-9)
 
 
 def test_failures_end_with_a_status_and_keep_completed_steps(tmp_path):

@@ -20,7 +20,11 @@ from fenics_contact.solvers.stepping import solve_load_path
 from fenics_contact.verification.hertz3d import force_for_radius, hertz_point_contact
 from fenics_contact.verification.hertz_sphere import HertzSphere, measure_hertz_sphere
 
-TOLERANCE = 0.02
+#: Relative tolerance on a (measured: 0.55 % linear, 0.20 % neo-Hookean) and
+#: P0_TOLERANCE on p0 (measured: 1.7 %, 1.2 %). E in place of E* = E / (1 - nu^2)
+#: moves a by 3.1 % and p0 by 6.5 %: both tolerances reject that (checked below).
+TOLERANCE = 0.01
+P0_TOLERANCE = 0.025
 
 
 def test_point_contact_formulas() -> None:
@@ -54,8 +58,11 @@ def test_linear_sphere_matches_hertz() -> None:
     assert c.fit.n_contact >= 40
     assert 0.05 < c.hertz.a / sphere.radius < 0.15
     assert abs(c.a_error) < TOLERANCE, (c.fit.a, c.hertz.a)
-    assert abs(c.p0_error) < TOLERANCE, (c.fit.p0, c.hertz.p0)
+    assert abs(c.p0_error) < P0_TOLERANCE, (c.fit.p0, c.hertz.p0)
     assert c.max_penetration < 1e-12
+    wrong = hertz_point_contact(c.P, sphere.radius, sphere.E, 0.0)  # E* = E
+    assert abs(c.fit.a / wrong.a - 1) > 2 * TOLERANCE
+    assert abs(c.fit.p0 / wrong.p0 - 1) > 2 * P0_TOLERANCE
 
 
 def test_neo_hookean_sphere_at_small_load_stays_close_to_hertz() -> None:
@@ -63,4 +70,4 @@ def test_neo_hookean_sphere_at_small_load_stays_close_to_hertz() -> None:
     assert path.converged
     c = measure_hertz_sphere(problem, sphere)
     assert abs(c.a_error) < TOLERANCE, (c.fit.a, c.hertz.a)
-    assert abs(c.p0_error) < 2 * TOLERANCE, (c.fit.p0, c.hertz.p0)
+    assert abs(c.p0_error) < P0_TOLERANCE, (c.fit.p0, c.hertz.p0)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
+import warnings
 from collections.abc import Sequence
 
 import fenics_contact  # noqa: F401  (imports the DOLFINx wheel first)
@@ -29,6 +30,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``fenics-contact`` command; returns the exit code."""
     args = build_parser().parse_args(argv)
+    warnings.showwarning = _one_line_warning
     try:
         return int(args.func(args))
     except (ValueError, FileNotFoundError, RuntimeError) as exc:
@@ -37,6 +39,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:  # Ctrl-C outside a run's clean stop (see fenics_contact.stop)
         print("fenics-contact: stopped by SIGINT", file=sys.stderr)
         return 130
+
+
+def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Scene warnings as one line, ``fenics-contact: warning: ...`` (others as usual)."""
+    from fenics_contact.scene.build import SceneWarning
+
+    if issubclass(category, SceneWarning):
+        print(f"fenics-contact: warning: {message}", file=sys.stderr)
+    else:
+        sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
 
 
 if __name__ == "__main__":

@@ -66,6 +66,9 @@ def _run(args: argparse.Namespace) -> int:
                 "in the folder it resumes; give only --resume."
             )
         out: Path = args.resume or args.out or Path("results") / scene.name
+        from fenics_contact.output.folders import prepare_output_folder
+
+        prepare_output_folder(out, MPI.COMM_WORLD)  # a bad --out ends here, before any mesh
         finished = [_checkpoint_step(out) if args.resume is not None else 0]
         try:
             return _solve(args, scene, out, stop, finished)
@@ -114,8 +117,9 @@ def _solve(
         done = len(path.steps) - 1
         print(
             f"fenics-contact: load step {failed.step} of {steps} did not converge "
-            f"({failed.status} after {failed.cutbacks} cut-backs); steps 1-{done} are in "
-            f"{out}/solution.xdmf",
+            f"({failed.status} after {failed.cutbacks} cut-backs"
+            + (f": {failed.message}" if failed.message else "")
+            + f"); steps 1-{done} are in {out}/solution.xdmf",
             file=sys.stderr,
         )
         return 1

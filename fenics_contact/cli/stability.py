@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from fenics_contact.cli.study import methods
@@ -13,7 +14,7 @@ def _stability(args: argparse.Namespace) -> int:
 
     from fenics_contact.output.io import write_csv, write_json
     from fenics_contact.output.sweep_plots import stability_plot
-    from fenics_contact.studies.stability import full_grid, run_grid, select
+    from fenics_contact.studies.stability import ERROR, full_grid, run_grid, select
 
     out: Path = args.out
     rank0 = MPI.COMM_WORLD.rank == 0
@@ -41,6 +42,15 @@ def _stability(args: argparse.Namespace) -> int:
     if rank0:
         stability_plot(records, out / "stability.png")
         print(f"\nWrote {out}/stability.csv, stability.json, stability.png and cases/*.json")
+    crashed = [r for r in records if r.status == ERROR]
+    if crashed:
+        if rank0:
+            print(
+                f"fenics-contact: {len(crashed)} run(s) ended with an error (a crash, not a "
+                f"solver status), first: {crashed[0].case} {crashed[0].method}: "
+                f"{crashed[0].message}", file=sys.stderr,
+            )
+        return 1
     return 0
 
 
@@ -59,7 +69,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Run methods on extreme cases (r 1e-8 ... 1e12 E/h, E 1e-3 ... 1e12, "
         "nu up to 0.4999, 1/10/100 load steps, initial penetration, grazing, no and full "
         "contact, coarse and fine meshes); write stability.csv, stability.json, "
-        "stability.png and per-run step records under cases/.",
+        "stability.png and per-run step records under cases/. Exit code 0, or 1 when a "
+        "run ended with an error (an exception, not a solver status).",
     )
     cmd.add_argument("--cases", type=_names, default=None,
                      help="comma-separated case names or groups (r, E, nu, steps, start, mesh, "

@@ -139,7 +139,8 @@ class DeformablePair:
         f2c = topology.connectivity(fdim, tdim)
         cells = np.array([f2c.links(f)[0] for f in facets], np.int64)
         cell_centre = (
-            x[domain.geometry.dofmaps[0][cells]].mean(axis=1) if facets.size else np.zeros((0, gdim))
+            x[domain.geometry.dofmaps[0][cells]].mean(axis=1)
+            if facets.size else np.zeros((0, gdim))
         )
         X = x[nodes]
         normal = self._normals(X)

@@ -138,7 +138,11 @@ class ContactState:
         active_count: global number of nodes with lam + r g < 0.
         max_penetration: global max of -min(g, 0) (length).
         contact_force: global normal force -int p dA on the reference surface
-            (force; per unit thickness in 2D).
+            (force; per unit thickness in 2D). Multiplier strategies report
+            -int lam dA: at convergence lam = p, and lam does not carry the
+            round-off of r g that p carries at huge r (at r = 1e12 E/h a gap
+            of 1e-15 makes r g of order one). The penalty method, whose
+            multiplier is zero, reports -int r min(g, 0) dA.
     """
 
     gap: np.ndarray
@@ -148,6 +152,21 @@ class ContactState:
     active_count: int
     max_penetration: float
     contact_force: float
+
+
+@dataclass(frozen=True)
+class DetFMinimum:
+    """Smallest det F = det(I + grad u) over the body's quadrature points.
+
+    Attributes:
+        value: the global minimum (1 undeformed, <= 0 inverted).
+        where: reference coordinates of the midpoint of the cell holding it
+            (length; 3 entries, z = 0 in 2D).
+    """
+
+    value: float
+    where: tuple[float, float, float]
+
 
 
 class ProblemBase:
@@ -208,6 +227,40 @@ class ProblemBase:
                 bcs.append(fem.dirichletbc(const, dofs, Vi))
         return bcs
 
+    def min_det_F(self) -> DetFMinimum:
+        """Smallest det F over the body (quadrature points of degree 2, all ranks).
+
+        The points are those of a degree-2 rule on the cell, where the strain
+        energy is integrated; one compiled expression per problem.
+        """
+        if not hasattr(self, "_det_expr"):
+            import basix
+
+            cell = self.domain.basix_cell()
+            points, _ = basix.make_quadrature(cell, 2)
+            F = ufl.Identity(self.domain.geometry.dim) + ufl.grad(self.u)
+            self._det_expr = fem.Expression(ufl.det(F), points)
+            self._det_cells = np.arange(
+                self.domain.topology.index_map(self.domain.topology.dim).size_local,
+                dtype=np.int32,
+            )
+        values = self._det_expr.eval(self.domain, self._det_cells)
+        per_cell = values.reshape(self._det_cells.size, -1).min(axis=1)
+        if per_cell.size:
+            worst = int(np.argmin(per_cell))
+            local = float(per_cell[worst])
+            where = mesh.compute_midpoints(
+                self.domain, self.domain.topology.dim, self._det_cells[worst : worst + 1]
+            )[0]
+        else:
+            local, where = np.inf, np.zeros(3)
+        if not np.isfinite(local):
+            local = -np.inf if np.isnan(local) else local
+        value, rank = self.comm.allreduce((local, self.comm.rank), op=MPI.MINLOC)
+        where = self.comm.bcast(np.asarray(where, float), root=rank)
+        return DetFMinimum(float(value), (float(where[0]), float(where[1]), float(where[2])))
+
+
     def snapshot(self) -> ProblemState:
         """Copy the unknowns and the load factor (see :meth:`restore`)."""
         return ProblemState(self.u.x.array.copy(), self.lam.x.array.copy(), self.load_factor)
@@ -223,6 +276,10 @@ class ProblemBase:
 
 class ContactProblem(ProblemBase):
     """One deformable body, one rigid obstacle, proportional loading."""
+
+    #: Whether lam is the contact pressure of the solution (the penalty method
+    #: sets False): chooses the contact-force formula.
+    multiplier_is_pressure = True
 
     def __init__(
         self,
@@ -284,6 +341,9 @@ class ContactProblem(ProblemBase):
         self._pressure_form = self.surface.nodal_form(self.pressure)
         self._force_form = fem.form(
             -self.pressure * self.surface.ds, entity_maps=self.surface.entity_maps
+        )
+        self._multiplier_force_form = fem.form(
+            -self.lam * self.surface.ds, entity_maps=self.surface.entity_maps
         )
 
     # -- parameters and loads -------------------------------------------------
@@ -379,9 +439,19 @@ class ContactProblem(ProblemBase):
                 float(np.max(-np.minimum(gap, 0.0), initial=0.0)) + 0.0, op=MPI.MAX
             ),
             contact_force=comm.allreduce(
-                fem.assemble_scalar(self._force_form), op=MPI.SUM
+                fem.assemble_scalar(self._contact_force_form()), op=MPI.SUM
             ),
         )
+
+    def _contact_force_form(self) -> fem.Form:
+        """The force from the multiplier when it is the pressure, else from min(lam + r g, 0).
+
+        At huge r the latter carries the round-off r * eps * g of the gap.
+        """
+        by_multiplier = getattr(self, "_multiplier_force_form", None)
+        if self.multiplier_is_pressure and by_multiplier is not None:
+            return by_multiplier
+        return self._force_form
 
     def active_signature(self) -> tuple[bytes, ...]:
         """A hashable fingerprint of the global active set (lam + r g < 0 at the nodes)."""

@@ -8,6 +8,7 @@ before any form is compiled.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -20,11 +21,16 @@ from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import material
 from fenics_contact.model.obstacles import RigidBall, RigidObstacle, RigidPlane
 from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement, SurfaceTraction
+from fenics_contact.model.rigid import free_rigid_motions
 
 if TYPE_CHECKING:
     from fenics_contact.model.pairs import TwoBodyProblem
 from fenics_contact.scene.meshing import mesh_on_rank, open_geo
 from fenics_contact.scene.schema import GENERATOR_TAGS, BoundarySpec, Scene, SceneError
+
+
+class SceneWarning(UserWarning):
+    """A scene that will run but probably not as meant (printed before the solve)."""
 
 
 @dataclass
@@ -76,38 +82,71 @@ def _open(gmsh: Any, scene: Scene) -> None:
         raise SceneError(f"{scene.path.name}: [mesh] parameters: {exc}") from None
 
 
-def _physical_dimensions(scene: Scene, comm: MPI.Comm) -> set[int]:
-    """Dimensions of the file's physical groups (read on rank 0, known to all)."""
+def _physical_groups(scene: Scene, comm: MPI.Comm) -> dict[tuple[int, int], str]:
+    """The file's physical groups, {(dim, tag): name}, read on rank 0, known to all.
+
+    A file gmsh cannot read raises SceneError (on every rank) naming it.
+    """
     import gmsh
 
-    found: set[int] | SceneError = set()
+    groups: dict[tuple[int, int], str] = {}
+    problem: str | None = None
     if comm.rank == 0:
         started = not gmsh.isInitialized()
         if started:
             gmsh.initialize(interruptible=False)
         try:
             _open(gmsh, scene)
-            found = {d for d, _ in gmsh.model.getPhysicalGroups()}
-        except SceneError as exc:
-            found = exc  # told to every rank below, so that none waits forever
+            for d, t in gmsh.model.getPhysicalGroups():
+                groups[(d, t)] = gmsh.model.getPhysicalName(d, t)
+        except Exception as exc:  # gmsh raises bare Exception
+            message = " ".join(str(exc).split()) or type(exc).__name__
+            problem = (
+                f"{scene.path.name}: [mesh] file = {str(scene.mesh.file)!r}: gmsh cannot read "
+                f"it ({message}); check that it is a complete .geo/.msh file."
+            )
         finally:
             gmsh.finalize() if started else gmsh.model.remove()
-    found = comm.bcast(found, root=0)
-    if isinstance(found, SceneError):
-        raise found
-    return found
+    groups, problem = comm.bcast((groups, problem), root=0)
+    if problem is not None:
+        raise SceneError(problem)
+    return groups
+
+
+def _check_tags(scene: Scene, groups: dict[tuple[int, int], str]) -> None:
+    """Every tag the scene names must be a facet physical group of the file."""
+    fdim = scene.dimension - 1
+    names = {name: tag for (d, tag), name in groups.items() if d == fdim and name}
+    numbers = {tag for (d, tag) in groups if d == fdim}
+    uses = [(f"dirichlet {i + 1}", b.tag) for i, b in enumerate(scene.dirichlet)]
+    uses += [(f"traction {i + 1}", b.tag) for i, b in enumerate(scene.tractions)]
+    if scene.contact.tag is not None:
+        uses.append(("contact", scene.contact.tag))
+    listing = ", ".join(
+        (f"{n} = {t}" if n else str(t))
+        for t, n in sorted((t, groups[(fdim, t)]) for t in numbers)
+    )
+    for section, tag in uses:
+        known = tag in names if isinstance(tag, str) else tag in numbers
+        if not known:
+            raise SceneError(
+                f"{scene.path.name}: [{section}] tag = {tag!r} is not a {fdim}D physical group "
+                f"of {scene.mesh.file.name}; available: {listing or 'none'}."
+            )
 
 
 def _from_gmsh(scene: Scene, comm: MPI.Comm) -> BodyMesh:
     spec = scene.mesh
     assert spec.file is not None
-    dims = _physical_dimensions(scene, comm)
+    groups = _physical_groups(scene, comm)
+    dims = {d for d, _ in groups}
     if scene.dimension not in dims:
         raise SceneError(
             f"{scene.path.name}: [scene] dimension = {scene.dimension}, but the mesh "
             f"{spec.file.name} has no {scene.dimension}D physical group; set the "
             "dimension to the mesh's or add a physical group for the body."
         )
+    _check_tags(scene, groups)  # before meshing: the file names its groups
 
     def build(gmsh: Any) -> None:
         _open(gmsh, scene)
@@ -257,12 +296,13 @@ def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProbl
         )
         for i, spec in enumerate(scene.tractions)
     ]
+    check_rigid_motions(scene, body, prescribed)
     obstacle = build_obstacle(scene, body.domain)
     settings = ContactSettings(
         r=scene.contact.r, relative=scene.contact.relative,
         quadrature=scene.contact.quadrature,  # type: ignore[arg-type]
     )
-    return ContactProblem(
+    problem = ContactProblem(
         body.domain,
         material(scene.law, scene.E, scene.nu),
         obstacle,
@@ -272,3 +312,47 @@ def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProbl
         tractions=tractions,
         obstacle_motion=scene.obstacle.motion,
     )
+    warn_initial_penetration(scene, problem)
+    return problem
+
+
+def check_rigid_motions(
+    scene: Scene, body: BodyMesh, prescribed: list[PrescribedDisplacement]
+) -> None:
+    """Raise SceneError naming the rigid motions no Dirichlet condition holds.
+
+    Contact and tractions do not count: before contact is made they hold
+    nothing and the stiffness is singular.
+    """
+    free = free_rigid_motions(body.domain, [(p.facets, p.value) for p in prescribed])
+    if free:
+        raise SceneError(
+            f"{scene.path.name}: the [[dirichlet]] conditions leave rigid motions of the body "
+            f"free ({'; '.join(free)}); contact does not hold them. Fix: prescribe more "
+            "components or facets (e.g. value = [0.0, 0.0] on a side, or a second side)."
+        )
+
+
+def initial_penetration(problem: ContactProblem) -> float:
+    """Largest penetration of the contact nodes into the obstacle at load factor 0 (length)."""
+    points = problem.nodal_coordinates()[:, : problem.domain.geometry.dim]
+    gap = problem.obstacle.gap_value(points) if points.size else np.zeros(0)
+    local = float(np.max(-np.minimum(gap, 0.0), initial=0.0))
+    return float(problem.comm.allreduce(local, op=MPI.MAX))
+
+
+def warn_initial_penetration(scene: Scene, problem: ContactProblem) -> float:
+    """Warn (SceneWarning) when the body starts inside the obstacle by more than h."""
+    depth = initial_penetration(problem)
+    h = problem.surface.h
+    if depth > h:
+        warnings.warn(
+            SceneWarning(
+                f"{scene.path.name}: the body starts {depth:.4g} inside the obstacle, more "
+                f"than the contact facet size h = {h:.4g} ({depth / h:.3g} h); expect squashed "
+                "or inverted elements. Move [obstacle] point/centre so the gap at load 0 is "
+                ">= 0, and let [obstacle] motion or [[dirichlet]] values bring contact."
+            ),
+            stacklevel=2,
+        )
+    return depth

@@ -333,6 +333,7 @@ def _mesh(path: Path, reader: _Reader, dimension: int) -> MeshSpec:
             raise reader.fail("file", f"no such mesh file ({file}); check the path.")
         if file.suffix not in (".geo", ".msh"):
             raise reader.fail("file", "must be a gmsh .geo or .msh file.")
+        _check_mesh_file(reader, file)
         return MeshSpec(file=file, parameters=dict(parameters))
     generator = reader.choice("generator", tuple(GENERATOR_TAGS))
     needed = {"rectangle": 2, "box": 3}[generator]
@@ -357,6 +358,26 @@ def _mesh(path: Path, reader: _Reader, dimension: int) -> MeshSpec:
         cells=tuple(cells),
         cell=reader.choice("cell", cell_types, default=cell_types[0]),
     )
+
+
+def _check_mesh_file(reader: _Reader, file: Path) -> None:
+    """A mesh file must be a readable, non-empty file; a .msh starts with $MeshFormat."""
+    if not file.is_file():
+        raise reader.fail("file", f"{file} is not a file; give a .geo or .msh file.")
+    try:
+        with file.open("rb") as stream:
+            head = stream.read(64)
+    except OSError as exc:
+        raise reader.fail(
+            "file", f"cannot read {file} ({exc.strerror}); check its permissions."
+        ) from None
+    if not head.strip():
+        raise reader.fail("file", f"{file} is empty; regenerate it (fenics-contact mesh).")
+    if file.suffix == ".msh" and not head.lstrip().startswith(b"$MeshFormat"):
+        raise reader.fail(
+            "file", f"{file} is not a gmsh .msh file (no $MeshFormat header); regenerate it "
+            "(fenics-contact mesh) or point to the .geo file."
+        )
 
 
 def _boundary(reader: _Reader, dimension: int, allow_free: bool) -> BoundarySpec:
@@ -499,10 +520,16 @@ def load_scene(path: Path | str) -> Scene:
     path = Path(path)
     if not path.exists():
         raise SceneError(f"Scene file {path} does not exist; check the path.")
+    if not path.is_file():
+        raise SceneError(f"Scene file {path} is not a file; give a .toml scene file.")
     try:
-        data = tomllib.loads(path.read_text())
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path.name}: not valid TOML ({exc}).") from None
+    except UnicodeDecodeError:
+        raise SceneError(f"{path.name}: not a text file (not UTF-8); give a TOML scene.") from None
+    except OSError as exc:
+        raise SceneError(f"Scene file {path} cannot be read ({exc.strerror}).") from None
     _check_keys(path, "", data)
     head = _table(path, data, "scene")
     dimension = head.table.get("dimension")

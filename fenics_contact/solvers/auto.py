@@ -42,7 +42,12 @@ from fenics_contact.model.problem import ContactProblem, ProblemState, Variation
 from fenics_contact.model.scaling import residual_floor
 from fenics_contact.solvers.base import NewtonStrategy, Observer, SolveResult, newton_loop, timed
 from fenics_contact.solvers.condensed import kernel_for
-from fenics_contact.solvers.diagnostics import ConvergenceMonitor, SolverSettings, Status
+from fenics_contact.solvers.diagnostics import (
+    ConvergenceMonitor,
+    SolverSettings,
+    Status,
+    signorini_admissibility,
+)
 from fenics_contact.solvers.newton import NewtonKernel
 
 
@@ -206,7 +211,10 @@ class AutoStrategy(NewtonStrategy):
 
     def _newton(self, settings: SolverSettings, tally: _Tally, *, line_search: bool) -> Status:
         """Newton on the Alart-Curnier system, plain or with backtracking."""
-        monitor = ConvergenceMonitor(settings, observer=self._progress(tally))
+        monitor = ConvergenceMonitor(
+            settings, observer=self._progress(tally),
+            admissible=signorini_admissibility(self.problem, settings),
+        )
         if line_search:
             status, steps = self._line_search_loop(self.kernel, monitor)
         else:

@@ -9,7 +9,12 @@ from typing import Protocol
 
 from fenics_contact.model.problem import ContactProblem, VariationalSystem
 from fenics_contact.solvers.condensed import kernel_for
-from fenics_contact.solvers.diagnostics import ConvergenceMonitor, SolverSettings, Status
+from fenics_contact.solvers.diagnostics import (
+    ConvergenceMonitor,
+    SolverSettings,
+    Status,
+    signorini_admissibility,
+)
 from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.newton import NewtonKernel
 
@@ -129,9 +134,22 @@ class NewtonStrategy:
         """The residual blocks this strategy's kernel solves."""
         raise NotImplementedError
 
+    #: Whether convergence also needs the Signorini conditions in their own
+    #: units (False for the penalty method, whose penetration is its regularisation).
+    exact_constraint = True
+
     def monitor(self, settings: SolverSettings | None = None) -> ConvergenceMonitor:
-        """A fresh convergence monitor reporting to the observer."""
-        return ConvergenceMonitor(settings or self.settings, observer=self.observer)
+        """A fresh convergence monitor reporting to the observer.
+
+        Unless the strategy regularises the constraint (penalty), converged
+        also needs the Signorini conditions in their own units.
+        """
+        settings = settings or self.settings
+        return ConvergenceMonitor(
+            settings, observer=self.observer,
+            admissible=signorini_admissibility(self.problem, settings)
+            if self.exact_constraint else None,
+        )
 
     def residual_norm(self) -> float:
         """The norm the stopping test reads (default: the kernel's residual)."""

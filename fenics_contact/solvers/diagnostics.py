@@ -4,12 +4,22 @@ Statuses, with their defined tests (checked in this order each iteration):
 
 - ``diverged``: the residual is NaN/inf, a linear solve failed, or the
   residual exceeds ``divergence_factor`` times the first residual of the solve.
-- ``converged``: the residual norm is at most ``max(atol, rtol * first)``.
+- ``converged``: the residual norm is at most ``max(atol, rtol * first)`` and,
+  for strategies that impose the constraint exactly, the Signorini
+  conditions hold in their own units (:func:`signorini_admissibility`): no
+  nodal penetration beyond ``gap_tol`` times the contact facet size and no
+  multiplier tension beyond ``tension_tol`` times E. A small residual alone
+  does not suffice: at tiny r the force-scaled complementarity residual
+  r g hides a gap.
 - ``cycling``: over the last ``cycle_window`` iterations the residual never
   fell below the smallest value seen before that window, and the active set
   (or, without one, the rounded residual) returned to a state it had left
   within the window (a pattern A -> B -> A).
 - ``max_iterations``: the iteration limit was reached (the paper's "> 500").
+
+Load stepping adds two statuses of its own: ``inverted`` (the solve
+converged but det F <= 0 somewhere in the body, so the step is refused) and
+``error`` (an exception ended the run; studies record it with its message).
 """
 
 from __future__ import annotations
@@ -29,6 +39,12 @@ class Status(StrEnum):
     CYCLING = "cycling"
     DIVERGED = "diverged"
     MAX_ITERATIONS = "max_iterations"
+    INVERTED = "inverted"
+    ERROR = "error"
+
+
+#: Every status a run, a step or a study record can carry.
+STATUSES = tuple(s.value for s in Status)
 
 
 @dataclass(frozen=True)
@@ -41,6 +57,10 @@ class SolverSettings:
         max_iterations: Newton iterations allowed in one solve (one load step).
         divergence_factor: residual growth over the first residual that means divergence.
         cycle_window: iterations inspected by the cycling test.
+        gap_tol: largest nodal penetration accepted at convergence, relative
+            to the contact facet size h (multiplier strategies only).
+        tension_tol: largest nodal multiplier tension (lam > 0) accepted at
+            convergence, relative to Young's modulus E.
     """
 
     atol: float = 1e-8
@@ -48,6 +68,8 @@ class SolverSettings:
     max_iterations: int = 50
     divergence_factor: float = 1e6
     cycle_window: int = 12
+    gap_tol: float = 1e-6
+    tension_tol: float = 1e-6
 
     def __post_init__(self) -> None:
         if not (self.atol >= 0 and self.rtol >= 0 and (self.atol > 0 or self.rtol > 0)):
@@ -56,6 +78,11 @@ class SolverSettings:
             )
         if self.max_iterations < 1:
             raise ValueError(f"max_iterations must be >= 1, got {self.max_iterations}.")
+        if not (self.gap_tol > 0 and self.tension_tol > 0):
+            raise ValueError(
+                f"gap_tol and tension_tol must be > 0 (gap_tol={self.gap_tol}, "
+                f"tension_tol={self.tension_tol})."
+            )
 
 
 @dataclass
@@ -65,6 +92,11 @@ class ConvergenceMonitor:
     settings: SolverSettings
     #: Called with (Newton iterations so far, residual) at every check (progress display).
     observer: Callable[[int, float], None] | None = None
+    #: Called when the residual passes its test: None when the iterate is an
+    #: acceptable solution, else the reason it is not (the solve goes on).
+    admissible: Callable[[], str | None] | None = None
+    #: The last reason ``admissible`` gave for refusing convergence.
+    refused: str | None = None
     residuals: list[float] = field(default_factory=list)
     states: list[Hashable] = field(default_factory=list)
     status: Status | None = None
@@ -93,7 +125,7 @@ class ConvergenceMonitor:
         s = self.settings
         if not math.isfinite(residual):
             self.status = Status.DIVERGED
-        elif residual <= self.tolerance():
+        elif residual <= self.tolerance() and self._accepted():
             self.status = Status.CONVERGED
         elif residual > s.divergence_factor * max(self.residuals[0], s.atol):
             self.status = Status.DIVERGED
@@ -102,6 +134,12 @@ class ConvergenceMonitor:
         elif self.iterations >= s.max_iterations:
             self.status = Status.MAX_ITERATIONS
         return self.status
+
+    def _accepted(self) -> bool:
+        if self.admissible is None:
+            return True
+        self.refused = self.admissible()
+        return self.refused is None
 
     def fail(self) -> Status:
         """Mark the solve diverged (a linear solve failed)."""
@@ -150,3 +188,41 @@ def signorini_report(gap: np.ndarray, pressure: np.ndarray, comm) -> SignoriniRe
             float(np.max(np.abs(gap * pressure), initial=0.0)), op=MPI.MAX
         ),
     )
+
+
+def signorini_admissibility(
+    problem, settings: SolverSettings
+) -> Callable[[], str | None] | None:
+    """The Signorini test of a converged iterate in its own units.
+
+    Returns a callable giving None when the largest nodal penetration is at
+    most ``settings.gap_tol * h`` (h: contact facet size) and the largest
+    multiplier tension at most ``settings.tension_tol * E``, else a sentence
+    naming the violation. Independent of r, unlike the residual. Only the
+    nodal rule enforces the conditions at the nodes; with the Gauss rule
+    (an integral constraint whose answer depends on r) there is no such
+    test and None is returned.
+    """
+    from mpi4py import MPI
+
+    if getattr(problem.surface, "quadrature", "nodal") != "nodal":
+        return None
+
+    h = float(problem.surface.h)
+    E = float(problem.material.E)
+
+    def check() -> str | None:
+        state = problem.contact_state()
+        tension = problem.comm.allreduce(
+            float(np.max(state.multiplier, initial=0.0)), op=MPI.MAX
+        )
+        if state.max_penetration > settings.gap_tol * h:
+            return (
+                f"penetration {state.max_penetration:.3g} > gap_tol * h = "
+                f"{settings.gap_tol:g} * {h:.3g}"
+            )
+        if tension > settings.tension_tol * E:
+            return f"tension {tension:.3g} > tension_tol * E = {settings.tension_tol:g} * {E:g}"
+        return None
+
+    return check

@@ -14,8 +14,10 @@ class Penalty(NewtonStrategy):
     """Newton on Pi + r/2 int min(g, 0)^2; the multiplier stays zero."""
 
     name = "penalty"
+    exact_constraint = False
 
     def build_system(self, problem: ContactProblem) -> VariationalSystem:
         """The penalised equilibrium; zeroing lam makes diagnostics report r min(g, 0)."""
         problem.lam.x.array[:] = 0.0
+        problem.multiplier_is_pressure = False
         return problem.penalty_system()

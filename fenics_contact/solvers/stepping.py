@@ -2,9 +2,16 @@
 
 The load factor goes from 0 to 1 in equal increments. A failed increment is
 undone (displacement and multiplier restored) and retried with half the
-increment, up to ``max_cutbacks`` times in a row; past that the path stops
+increment, up to ``max_cutbacks`` times in a row, and never below the step's
+increment / 2**max_cutbacks (a limit the load cannot pass, such as inverted
+elements at a fixed load, would otherwise halve it forever); past that the path stops
 with the failing status, and the steps already converged are kept (the
 ``on_step`` callback has written them).
+
+A converged solve is accepted only when det F > 0 at every quadrature point
+of the body (:meth:`ContactProblem.min_det_F`); otherwise the attempt counts
+as failed with status ``inverted`` and is cut back like any other failure.
+A path that ends ``inverted`` names the worst cell in ``StepRecord.message``.
 """
 
 from __future__ import annotations
@@ -35,6 +42,10 @@ class StepRecord:
         max_penetration: largest nodal penetration (length).
         contact_force: total normal contact force (force, per thickness in 2D).
         wall_s: wall-clock time of the step (seconds).
+        min_det_F: smallest det F over the body at the end of the step (1
+            undeformed; <= 0 means inverted elements).
+        worst_cell: reference midpoint of the cell holding ``min_det_F``.
+        message: why the step failed (empty when it converged).
     """
 
     step: int
@@ -49,6 +60,9 @@ class StepRecord:
     max_penetration: float = 0.0
     contact_force: float = 0.0
     wall_s: float = 0.0
+    min_det_F: float = 1.0
+    worst_cell: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    message: str = ""
 
     def to_dict(self) -> dict:
         """Plain-data view for JSON."""
@@ -175,6 +189,20 @@ def _absorb(record: StepRecord, result: SolveResult, run: RunRecord) -> None:
     record.residuals.append(result.residuals)
 
 
+def _failure_message(record: StepRecord, t_try: float) -> str:
+    if record.status == Status.INVERTED:
+        x = ", ".join(f"{c:.4g}" for c in record.worst_cell)
+        return (
+            f"elements inverted (det F = {record.min_det_F:.3g} <= 0) near ({x}) at load "
+            f"factor {t_try:.4g}, even with the increment halved {record.cutbacks - 1} times; "
+            "reduce the load, its initial penetration or r, or refine the mesh there"
+        )
+    return (
+        f"{record.status} at load factor {t_try:.4g} with the increment halved "
+        f"{record.cutbacks - 1} times"
+    )
+
+
 def start_record(strategy: Strategy) -> RunRecord:
     """An empty record (status ``running``) carrying the strategy's and problem's context."""
     problem = strategy.problem
@@ -224,6 +252,7 @@ def solve_load_path(
         start = time.perf_counter()
         increment = target - t
         halvings = 0
+        smallest = increment / 2**max_cutbacks
         while t < target - 1e-14:
             t_try = min(t + increment, target)
             saved = problem.snapshot()
@@ -232,16 +261,22 @@ def solve_load_path(
             _absorb(step, result, run)
             if on_iteration is not None:
                 on_iteration(step, result)
+            status = result.status
             if result.converged:
-                t = t_try
-                halvings = 0
-                continue
+                det = problem.min_det_F()
+                step.min_det_F, step.worst_cell = det.value, det.where
+                if det.value > 0.0:
+                    t = t_try
+                    halvings = 0
+                    continue
+                status = Status.INVERTED
             problem.restore(saved)
             step.cutbacks += 1
             halvings += 1
-            if halvings > max_cutbacks:
-                step.status = result.status.value
+            if halvings > max_cutbacks or increment / 2 < smallest * (1 - 1e-12):
+                step.status = status.value
                 step.load_factor = t
+                step.message = _failure_message(step, t_try)
                 break
             increment /= 2
         step.wall_s = time.perf_counter() - start

@@ -32,7 +32,7 @@ from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.scaling import DEFAULT_FORCE_RTOL, scaled_atol
 from fenics_contact.output.io import write_json
 from fenics_contact.solvers import STRATEGIES, make_strategy
-from fenics_contact.solvers.diagnostics import SolverSettings
+from fenics_contact.solvers.diagnostics import SolverSettings, Status
 from fenics_contact.solvers.stepping import RunRecord, StepRecord, solve_load_path, start_record
 from fenics_contact.verification.bench_scenes import BarScene, BlockScene, HertzScene
 from fenics_contact.verification.two_body_examples import IroningShort, TwoCylinders
@@ -40,8 +40,9 @@ from fenics_contact.verification.two_body_examples import IroningShort, TwoCylin
 #: Methods the stability grid runs by default.
 METHODS = tuple(STRATEGIES)
 
-#: Extra statuses of a run besides the solver statuses.
-ERROR = "error"
+#: Extra statuses of a run besides the solver statuses: an exception (with
+#: its message in ``CaseRecord.message``) and non-finite outputs.
+ERROR = Status.ERROR.value
 NONFINITE = "nonfinite"
 
 
@@ -124,6 +125,10 @@ class CaseRecord(RunRecord):
     load_steps: int = 0
     max_abs_u: float = 0.0
     atol: float = 0.0
+    #: Root mean square of the nodal displacement components (length): a
+    #: displacement measure to compare with a reference (max |u| is often
+    #: the prescribed value).
+    u_rms: float = 0.0
 
     def row(self) -> dict[str, object]:
         """Flat row; no ``error`` column (the grid has no reference solutions)."""
@@ -176,9 +181,14 @@ def run_case(
         )
         local_u = float(np.max(np.abs(problem.u.x.array), initial=0.0))
         record.max_abs_u = comm.allreduce(local_u, op=MPI.MAX)
-        if not _finite(record.max_abs_u, record.max_penetration, record.contact_force):
+        n_owned = problem.V.dofmap.index_map.size_local * problem.V.dofmap.index_map_bs
+        owned = problem.u.x.array[:n_owned]
+        total = comm.allreduce(float(np.dot(owned, owned)), op=MPI.SUM)
+        record.u_rms = math.sqrt(total / max(comm.allreduce(n_owned, op=MPI.SUM), 1))
+        if not _finite(record.max_abs_u, record.u_rms, record.max_penetration,
+                       record.contact_force):
             record.status = NONFINITE
-            record.max_abs_u = 0.0
+            record.max_abs_u = record.u_rms = 0.0
             for step in record.steps:
                 step.max_penetration = step.contact_force = 0.0
     except Exception as exc:

@@ -133,6 +133,8 @@ STATUS_WORDS = {
     Status.CYCLING.value: "cycling",
     Status.DIVERGED.value: "divergence",
     Status.MAX_ITERATIONS.value: "> {limit}",
+    Status.INVERTED.value: "inverted",
+    Status.ERROR.value: "error",
 }
 
 

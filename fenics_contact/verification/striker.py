@@ -80,6 +80,11 @@ class TargetSurface:
     length: float
 
     @property
+    def h(self) -> float:
+        """Size of the target facet (length): the scale of the Signorini test."""
+        return self.length
+
+    @property
     def num_dofs(self) -> int:
         """Global number of multiplier degrees of freedom (one: the striker's force)."""
         return self.Q.dofmap.index_map.size_global

@@ -1,0 +1,140 @@
+"""Which rigid motions of a body its Dirichlet conditions leave free.
+
+A rigid motion u(x) = a + w x (x - c) (2D: one rotation about z) is held when
+some prescribed component at some constrained node does not vanish for it.
+Collect, for every prescribed component i and every node p of its facets,
+the row of the rigid-mode basis evaluated at p in component i; the motions
+left free are the null space of that matrix. Contact and penalty terms do not
+count: before contact is made they hold nothing, and a singular stiffness is
+what a Newton solve then meets.
+
+The check works on the Gram matrix M^T M (at most 6 x 6), summed over the
+MPI ranks, with coordinates centred on the body's bounding box and scaled by
+its size so that translations and rotations weigh alike.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from dolfinx import mesh
+
+from mpi4py import MPI
+
+_AXES = "xyz"
+
+
+def _basis(points: np.ndarray, component: int, gdim: int) -> np.ndarray:
+    """Rows: component ``component`` of each rigid mode at ``points`` (n, gdim)."""
+    n = points.shape[0]
+    if gdim == 2:
+        x, y = points[:, 0], points[:, 1]
+        modes = [np.full(n, component == 0, float), np.full(n, component == 1, float),
+                 -y if component == 0 else x]  # rotation about z: (-y, x)
+        return np.column_stack(modes)
+    x, y, z = points[:, 0], points[:, 1], points[:, 2]
+    # rotations about x: (0, -z, y); about y: (z, 0, -x); about z: (-y, x, 0)
+    rot = {
+        0: [np.zeros(n), z, -y],
+        1: [-z, np.zeros(n), x],
+        2: [y, -x, np.zeros(n)],
+    }[component]
+    trans = [np.full(n, component == k, float) for k in range(3)]
+    return np.column_stack(trans + rot)
+
+
+def _names(gdim: int) -> list[str]:
+    if gdim == 2:
+        return ["translation in x", "translation in y", "rotation in the x-y plane"]
+    return [f"translation in {a}" for a in _AXES] + [f"rotation about the {a} axis" for a in _AXES]
+
+
+def free_rigid_motions(
+    domain: mesh.Mesh,
+    conditions: Sequence[tuple[np.ndarray, Sequence[float | None]]],
+) -> list[str]:
+    """Names of the rigid motions that the prescribed components leave free.
+
+    Args:
+        domain: the body mesh.
+        conditions: (local facet indices, value per component with None for a
+            free component) of each Dirichlet condition.
+
+    Returns:
+        An empty list when every rigid motion is held, else one phrase per
+        free motion (e.g. "translation in x", "rotation about the z axis
+        through (0.5, 0)"), collective over the mesh's communicator.
+    """
+    gdim = domain.geometry.dim
+    tdim = domain.topology.dim
+    comm = domain.comm
+    x = domain.geometry.x[:, :gdim]
+    lo = np.empty(gdim)
+    hi = np.empty(gdim)
+    comm.Allreduce(x.min(axis=0) if x.size else np.full(gdim, np.inf), lo, op=MPI.MIN)
+    comm.Allreduce(x.max(axis=0) if x.size else np.full(gdim, -np.inf), hi, op=MPI.MAX)
+    centre = 0.5 * (lo + hi)
+    size = float(np.max(hi - lo)) or 1.0
+    n_modes = 3 if gdim == 2 else 6
+    gram = np.zeros((n_modes, n_modes))
+    domain.topology.create_connectivity(tdim - 1, 0)
+    for facets, value in conditions:
+        facets = np.asarray(facets, dtype=np.int32)
+        if facets.size == 0:
+            continue
+        vertices = np.unique(mesh.entities_to_geometry(domain, tdim - 1, facets).ravel())
+        points = (x[vertices] - centre) / size
+        for component, v in enumerate(value):
+            if v is None:
+                continue
+            rows = _basis(points, component, gdim)
+            gram += rows.T @ rows
+    total = np.empty_like(gram)
+    comm.Allreduce(gram, total, op=MPI.SUM)
+    gram = total
+    eigenvalues, vectors = np.linalg.eigh(gram)
+    scale = max(float(eigenvalues.max()), 1.0)
+    null = vectors[:, eigenvalues <= 1e-10 * scale]
+    if null.shape[1] == 0:
+        return []
+    names = _names(gdim)
+    free: list[str] = []
+    projector = null @ null.T
+    for k in range(n_modes):
+        e = np.zeros(n_modes)
+        e[k] = 1.0
+        if np.linalg.norm(projector @ e) > 1 - 1e-8:
+            free.append(names[k] + (f" about ({_fmt(centre)})" if "rotation" in names[k] and
+                                    gdim == 2 else ""))
+    # motions of the null space not spanned by the pure modes named above
+    named = [k for k in range(n_modes) if np.linalg.norm(projector[:, k]) > 1 - 1e-8]
+    remaining = null.shape[1] - len(named)
+    if remaining > 0:
+        rest = null - (np.eye(n_modes)[:, named] @ np.eye(n_modes)[named, :]) @ null
+        u, _, _ = np.linalg.svd(rest)
+        for j in range(remaining):
+            free.append(_describe(u[:, j], centre, size, gdim))
+    return free
+
+
+def _fmt(point: np.ndarray) -> str:
+    return ", ".join(f"{c:.4g}" for c in point)
+
+
+def _describe(mode: np.ndarray, centre: np.ndarray, size: float, gdim: int) -> str:
+    """A rigid mode (translation, rotation) in scaled coordinates, in words."""
+    if gdim == 2:
+        a, w = mode[:2], mode[2]
+        if abs(w) < 1e-8:
+            return f"translation along ({_fmt(a / np.linalg.norm(a))})"
+        # u = a + w (-y, x) vanishes at the point c with a = w (c_y, -c_x)
+        c = np.array([-a[1] / w, a[0] / w]) * size + centre
+        return f"rotation in the x-y plane about ({_fmt(c)})"
+    a, w = mode[:3], mode[3:]
+    if np.linalg.norm(w) < 1e-8:
+        return f"translation along ({_fmt(a / np.linalg.norm(a))})"
+    axis = w / np.linalg.norm(w)
+    # a = -w x c (+ a screw part along w); c = (w x a) / |w|^2 is the nearest axis point
+    c = np.cross(w, a) / np.dot(w, w) * size + centre
+    return f"rotation about the axis ({_fmt(axis)}) through ({_fmt(c)})"

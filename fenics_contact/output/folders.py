@@ -1,0 +1,56 @@
+"""Check an output folder before any heavy work: it exists or can be made, and takes files."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+
+class OutputFolderError(ValueError):
+    """The output folder cannot be created or written; the message names it and the fix."""
+
+
+def prepare_output_folder(out: Path, comm=None) -> Path:
+    """Prove that ``out`` can be created (with parents) and written, creating nothing.
+
+    Raises :class:`OutputFolderError` (one line: the folder, the reason, the
+    fix) instead of the OSError a solver would meet after minutes of work.
+    With an MPI communicator, rank 0 checks and every rank raises alike.
+    """
+    if comm is None or comm.size == 1:
+        return _prepare(Path(out))
+    problem = None
+    if comm.rank == 0:
+        try:
+            _prepare(Path(out))
+        except OutputFolderError as exc:
+            problem = str(exc)
+    problem = comm.bcast(problem, root=0)
+    if problem is not None:
+        raise OutputFolderError(problem)
+    return Path(out)
+
+
+def _prepare(out: Path) -> Path:
+    """Check without leaving a trace: the nearest existing ancestor takes a new entry."""
+    out = out.absolute()
+    existing = out
+    while not existing.exists():
+        existing = existing.parent
+    if not existing.is_dir():
+        what = "an existing file" if existing == out else f"below the file {existing}"
+        raise OutputFolderError(
+            f"cannot create output folder {out}: it is {what}, not a folder; "
+            "choose another --out."
+        )
+    try:
+        probe = tempfile.mkdtemp(prefix=".write-test-", dir=existing)
+        os.rmdir(probe)
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        raise OutputFolderError(
+            f"cannot write to output folder {out} ({existing}: {reason}); "
+            "choose a writable --out."
+        ) from None
+    return out

@@ -1,0 +1,428 @@
+"""Every raise site of scene validation (schema.py) and building (build.py) has a case here.
+
+Each case is a small TOML scene (a valid base with one edit) and the words the
+message must contain: the key, the bad value or the fix. Building cases use a
+4 x 2 generated mesh or a tiny gmsh file, and fail before any form is compiled.
+"""
+
+import math
+import re
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fenics_contact.cli import main
+from fenics_contact.scene.schema import SceneError, _Reader, load_scene
+
+MESHES = Path(__file__).parent.parent / "meshes"
+
+
+def base() -> dict:
+    """A valid 2D scene: a block held on top, pressed onto a plane below."""
+    return {
+        "scene": {"name": "s", "dimension": 2},
+        "mesh": {"generator": "rectangle", "size": [1.0, 0.5], "cells": [4, 2]},
+        "material": {"law": "svk", "E": 210.0, "nu": 0.3},
+        "dirichlet": [{"tag": "top", "value": [0.0, -0.05]}],
+        "obstacle": {"type": "plane", "point": [0.0, 0.0], "normal": [0.0, 1.0]},
+        "contact": {"tag": "bottom", "r": 1.0},
+        "solver": {"steps": 1},
+        "output": {"pictures": False},
+    }
+
+
+def _value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, str):
+        return '"' + v + '"'
+    if isinstance(v, float) and math.isinf(v):
+        return "inf" if v > 0 else "-inf"
+    if isinstance(v, list):
+        return "[" + ", ".join(_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{k} = {_value(x)}" for k, x in v.items()) + " }"
+    return repr(v)
+
+
+def to_toml(scene: dict) -> str:
+    """A tiny TOML writer for these tests (tables, arrays of tables, scalars)."""
+    top = [f"{k} = {_value(v)}" for k, v in scene.items() if not isinstance(v, dict | list)
+           or (isinstance(v, list) and not all(isinstance(t, dict) for t in v))]
+    lines = top[:]
+    for name, table in scene.items():
+        if isinstance(table, dict):
+            lines.append(f"[{name}]")
+            lines += [f"{k} = {_value(v)}" for k, v in table.items()]
+        elif isinstance(table, list) and table and all(isinstance(t, dict) for t in table):
+            for t in table:
+                lines.append(f"[[{name}]]")
+                lines += [f"{k} = {_value(v)}" for k, v in t.items()]
+    return "\n".join(lines) + "\n"
+
+
+def write(tmp_path: Path, scene: dict | str, name: str = "scene.toml") -> Path:
+    path = tmp_path / name
+    path.write_text(scene if isinstance(scene, str) else to_toml(scene))
+    return path
+
+
+def edit(**changes):
+    """A scene editor: section=value replaces a table, "section.key"=value sets a key
+    (None deletes it)."""
+
+    def apply(scene: dict) -> dict:
+        for where, value in changes.items():
+            section, _, key = where.partition("__")
+            if not key:
+                if value is None:
+                    scene.pop(section, None)
+                else:
+                    scene[section] = value
+                continue
+            table = scene[section][0] if isinstance(scene[section], list) else scene[section]
+            if value is None:
+                table.pop(key, None)
+            else:
+                table[key] = value
+        return scene
+
+    return apply
+
+
+# (id, edit of the base scene, regex the SceneError message must match)
+SCHEMA_CASES = [
+    ("number-missing", edit(material__E=None), r"\[material\] E is missing: give a number"),
+    ("number-type", edit(material__E="big"), r"\[material\] E = 'big': must be a number"),
+    ("number-finite", edit(material__E=math.inf), r"\[material\] E = inf: must be finite"),
+    ("number-positive", edit(contact__r=0.0), r"\[contact\] r = 0.0: must be > 0"),
+    ("integer", edit(solver__steps=0), r"\[solver\] steps = 0: must be an integer >= 1"),
+    ("integer-type", edit(solver__max_cutbacks=1.5), r"max_cutbacks = 1.5: must be an integer"),
+    ("flag", edit(contact__relative="yes"), r"\[contact\] relative = 'yes': must be true or"),
+    ("choice", edit(solver__method="newton"), r"method = 'newton': choose one of penalty"),
+    ("vector-missing", edit(obstacle__point=None), r"\[obstacle\] point is missing: give 2"),
+    ("vector-length", edit(obstacle__normal=[0.0, 1.0, 0.0]), r"normal.*list of 2 numbers"),
+    ("vector-entry", edit(dirichlet__value=[0.0, "x"]), r'entries must be finite numbers or "'),
+    ("tag-type", edit(contact__tag=1.5), r"\[contact\] tag = 1.5: give a facet tag number or a"),
+    ("unknown-key", edit(solver__stpes=3), r"unknown key 'stpes'.*Did you mean 'steps'"),
+    ("unknown-top", edit(solvers={"steps": 1}), r"unknown key 'solvers' at top level"),
+    ("table-missing", edit(material=None), r"the \[material\] table is missing; add it"),
+    ("table-type", edit(obstacle=[1, 2]), r"\[obstacle\] must be a table, not list"),
+    ("array-type", edit(dirichlet={"tag": "top", "value": [0.0, 0.0]}), r"use \[\[dirichlet\]\]"),
+    ("mesh-both", edit(mesh__file="x.msh"), r"\[mesh\] needs exactly one of 'file'"),
+    ("mesh-none", edit(mesh={"size": [1.0, 1.0]}), r"\[mesh\] needs exactly one of 'file'"),
+    ("parameters", edit(mesh__parameters={"h": "fine"}), r"parameters.*must be a table of numbers"),
+    ("generator-dim", edit(mesh__generator="box"), r"makes a 3D mesh but \[scene\] dimension = 2"),
+    ("size", edit(mesh__size=[1.0, 0.0]), r"\[mesh\] size.*every side length must be > 0"),
+    ("cells", edit(mesh__cells=[4, 0]), r"\[mesh\] cells = \[4, 0\]: must be 2 positive integers"),
+    ("bounds", edit(dirichlet__x=[1.0, 0.0]), r"x = \[1.0, 0.0\]: must be \[min, max\]"),
+    ("normal-zero", edit(obstacle__normal=[0.0, 0.0]), r"normal.*must be a nonzero vector"),
+    ("ball-radius", edit(obstacle={"type": "ball", "centre": [0.5, -1.0], "radius": -1.0}),
+     r"\[obstacle\] radius = -1.0: must be > 0"),
+    ("contact-both", edit(contact__detect=True), r"either 'tag'.*or 'detect = true'"),
+    ("contact-neither", edit(contact__tag=None), r"either 'tag'.*not both or neither"),
+    ("dimension", edit(scene__dimension=4), r"dimension = 4: use 2 \(plane strain\) or 3"),
+    ("dimension-missing", edit(scene__dimension=None), r"dimension = None: use 2"),
+    ("kinematics", edit(material__kinematics="small"), r"kinematics.*small strain is law"),
+    ("fields", edit(output__fields=["stress"]), r"\[output\] fields = \['stress'\]: choose from"),
+    ("nu-high", edit(material__nu=0.5), r"nu = 0.5: must be < 0.5.*0.4999"),
+    ("nu-low", edit(material__nu=-1.0), r"nu = -1.0: must be > -1"),
+]
+
+
+@pytest.mark.parametrize(("edit_scene", "message"), [c[1:] for c in SCHEMA_CASES],
+                         ids=[c[0] for c in SCHEMA_CASES])
+def test_schema_mistake_is_named(tmp_path, edit_scene, message):
+    path = write(tmp_path, edit_scene(base()))
+    with pytest.raises(SceneError, match=message) as info:
+        load_scene(path)
+    assert "\n" not in str(info.value)
+
+
+def test_base_scene_is_valid(tmp_path):
+    scene = load_scene(write(tmp_path, base()))
+    assert (scene.dimension, scene.E, scene.solver.steps) == (2, 210.0, 1)
+
+
+def test_number_below_bound_is_named():
+    reader = _Reader(Path("s.toml"), "material", {"nu": 0.7})
+    with pytest.raises(SceneError, match=r"\[material\] nu = 0.7: must be < 0.5"):
+        reader.number("nu", below=0.5)
+
+
+def test_scene_file_missing_directory_toml_and_binary(tmp_path):
+    with pytest.raises(SceneError, match="does not exist; check the path"):
+        load_scene(tmp_path / "nothing.toml")
+    with pytest.raises(SceneError, match="is not a file"):
+        load_scene(tmp_path)
+    with pytest.raises(SceneError, match="not valid TOML"):
+        load_scene(write(tmp_path, "[scene\nname = 1\n"))
+    binary = tmp_path / "b.toml"
+    binary.write_bytes(b"\xff\xfe\x00\x81")
+    with pytest.raises(SceneError, match="not a text file"):
+        load_scene(binary)
+
+
+def test_unreadable_scene_file(tmp_path, monkeypatch):
+    path = write(tmp_path, base())
+
+    def refuse(self, *args, **kwargs):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(Path, "read_text", refuse)
+    with pytest.raises(SceneError, match=r"scene.toml cannot be read \(Permission denied\)"):
+        load_scene(path)
+
+
+# -- mesh files ----------------------------------------------------------------------
+def _file_scene(tmp_path, name, content: bytes | None, **extra):
+    if content is not None:
+        (tmp_path / name).write_bytes(content)
+    scene = base()
+    scene["mesh"] = {"file": name, **extra}
+    return write(tmp_path, scene)
+
+
+@pytest.mark.parametrize(
+    ("name", "content", "message"),
+    [
+        ("gone.msh", None, r"no such mesh file"),
+        ("mesh.txt", b"x", r"must be a gmsh .geo or .msh file"),
+        ("empty.msh", b"", r"empty.msh is empty; regenerate it"),
+        ("blank.geo", b"  \n", r"blank.geo is empty"),
+        ("fake.msh", b"solid ascii\nendsolid\n", r"no \$MeshFormat header"),
+    ],
+)
+def test_mesh_file_mistake_is_named(tmp_path, name, content, message):
+    with pytest.raises(SceneError, match=message):
+        load_scene(_file_scene(tmp_path, name, content))
+
+
+def test_mesh_file_that_is_a_folder(tmp_path):
+    (tmp_path / "dir.msh").mkdir()
+    with pytest.raises(SceneError, match=r"dir.msh is not a file"):
+        load_scene(_file_scene(tmp_path, "dir.msh", None))
+
+
+def test_unreadable_mesh_file(tmp_path, monkeypatch):
+    path = _file_scene(tmp_path, "m.msh", b"$MeshFormat\n")
+
+    real_open = Path.open
+
+    def refuse(self, *args, **kwargs):
+        if self.suffix == ".msh":
+            raise PermissionError(13, "Permission denied")
+        return real_open(self, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "open", refuse)
+    with pytest.raises(SceneError, match=r"cannot read .*m.msh \(Permission denied\)"):
+        load_scene(path)
+
+
+CORRUPT_MSH = b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\ngarbage\n"
+
+
+@pytest.mark.parametrize("how", ["main", "subprocess"])
+def test_corrupt_mesh_exits_2_with_one_line(tmp_path, capsys, how):
+    import subprocess
+    import sys
+
+    path = _file_scene(tmp_path, "bad.msh", CORRUPT_MSH)
+    out = tmp_path / "out"
+    if how == "main":
+        code = main(["run", str(path), "--out", str(out), "--quiet"])
+        err = capsys.readouterr().err.strip()
+    else:
+        done = subprocess.run(
+            [sys.executable, "-m", "fenics_contact.cli", "run", str(path), "--out", str(out),
+             "--quiet"], capture_output=True, text=True, timeout=120,
+        )
+        code, err = done.returncode, done.stderr.strip()
+    assert code == 2
+    assert len(err.splitlines()) == 1, err
+    assert re.search(r"bad.msh.*gmsh cannot read it \(Could not read nodes\)", err)
+    assert not out.exists()
+
+
+def test_geo_with_a_syntax_error_exits_2(tmp_path, capsys):
+    path = _file_scene(tmp_path, "broken.geo", b"Point(1) = {0, 0, 0;\nnot geo\n")
+    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1, err
+    assert re.search(r"broken.geo.*gmsh cannot read it \(.*line 1: syntax error", err), err
+
+
+# -- building (needs the mesh, still before any form) ----------------------------------
+def _build(path):
+    from fenics_contact.scene.build import build_problem
+
+    return build_problem(load_scene(path))
+
+
+def test_geo_without_body_of_scene_dimension(tmp_path):
+    geo = tmp_path / "curves.geo"
+    geo.write_text(
+        'SetFactory("OpenCASCADE");\nRectangle(1) = {0, 0, 0, 1, 0.5};\n'
+        "Physical Curve(3) = {1};\n"
+    )
+    scene = base()
+    scene["mesh"] = {"file": "curves.geo"}
+    with pytest.raises(SceneError, match=r"has no 2D physical group"):
+        _build(write(tmp_path, scene))
+
+
+def test_tag_mistake_found_before_meshing(tmp_path, monkeypatch):
+    """The .geo names its groups: a wrong tag fails before gmsh generates a mesh."""
+    import fenics_contact.scene.build as build
+
+    def no_meshing(*args, **kwargs):
+        raise AssertionError("the mesh was generated")
+
+    monkeypatch.setattr(build, "mesh_on_rank", no_meshing)
+    scene = base()
+    scene["mesh"] = {"file": str(MESHES / "hertz_cylinder.geo")}
+    scene["contact"]["tag"] = "underside"
+    with pytest.raises(SceneError, match=r"\[contact\] tag = 'underside' is not a 1D physical "
+                       r"group of hertz_cylinder.geo; available: .*top = 2.*contact = 3"):
+        _build(write(tmp_path, scene))
+    scene["contact"]["tag"] = "contact"
+    scene["dirichlet"][0]["tag"] = 7
+    with pytest.raises(SceneError, match=r"\[dirichlet 1\] tag = 7 is not a 1D physical"):
+        _build(write(tmp_path, scene))
+
+
+def test_mesh_without_boundary_groups(tmp_path):
+    geo = tmp_path / "plain.geo"
+    geo.write_text(
+        'SetFactory("OpenCASCADE");\nRectangle(1) = {0, 0, 0, 1, 0.5};\n'
+        "Physical Surface(1) = {1};\nMesh.MeshSizeMax = 0.25;\n"
+    )
+    scene = base()
+    scene["mesh"] = {"file": "plain.geo"}
+    scene["dirichlet"] = []
+    scene["contact"] = {"detect": True, "margin": 0.1}
+    with pytest.raises(SceneError, match=r"the mesh has no physical groups on its boundary"):
+        _build(write(tmp_path, scene))
+
+
+def test_generated_mesh_tag_mistake_lists_names(tmp_path):
+    scene = base()
+    scene["contact"]["tag"] = "underside"
+    with pytest.raises(SceneError, match=r"\[contact\] tag = 'underside' is not a facet tag.*"
+                       r"left = 1, right = 2, bottom = 3, top = 4"):
+        _build(write(tmp_path, scene))
+
+
+def test_mesh_dimension_disagreeing_with_scene(tmp_path, monkeypatch):
+    from dolfinx import mesh
+
+    from mpi4py import MPI
+
+    import fenics_contact.scene.build as build
+
+    def cube(scene, comm):
+        domain = mesh.create_unit_cube(MPI.COMM_WORLD, 1, 1, 1)
+        tags = mesh.meshtags(domain, 2, np.zeros(0, np.int32), np.zeros(0, np.int32))
+        return build.BodyMesh(domain, tags, {})
+
+    monkeypatch.setattr(build, "build_mesh", cube)
+    with pytest.raises(SceneError, match=r"dimension = 2 but the mesh is 3D"):
+        _build(write(tmp_path, base()))
+
+
+def test_dirichlet_bounds_selecting_nothing(tmp_path):
+    scene = base()
+    scene["dirichlet"][0]["x"] = [5.0, 6.0]
+    with pytest.raises(SceneError, match=r"\[\[dirichlet\]\] 1 selects no facet; widen"):
+        _build(write(tmp_path, scene))
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize(
+    ("dirichlet", "free"),
+    [
+        ([], "translation in x; translation in y; rotation in the x-y plane about (0.5, 0.25)"),
+        ([{"tag": "bottom", "value": ["free", 0.0]}], "translation in x"),
+        ([{"tag": "top", "value": [0.0, "free"]}, {"tag": "bottom", "value": [0.0, "free"]}],
+         "translation in y"),
+    ],
+    ids=["none", "roller", "two-rollers"],
+)
+def test_rigid_motions_left_free_are_named(tmp_path, dirichlet, free):
+    scene = base()
+    scene["dirichlet"] = dirichlet
+    scene["traction"] = [{"tag": "top", "value": [0.0, -1.0]}] if not dirichlet else []
+    if not dirichlet:
+        scene.pop("dirichlet")
+    with pytest.raises(SceneError, match=re.escape(f"free ({free}); contact does not hold")):
+        _build(write(tmp_path, scene))
+
+
+@pytest.mark.mpi
+def test_free_rigid_motions_3d_and_pin():
+    from dolfinx import mesh
+
+    from mpi4py import MPI
+
+    from fenics_contact.model.rigid import free_rigid_motions
+
+    box = mesh.create_box(MPI.COMM_WORLD, [[0, 0, 0], [1, 1, 1]], [2, 2, 2])
+    box.topology.create_connectivity(2, 3)
+    base_facets = mesh.locate_entities_boundary(box, 2, lambda x: np.isclose(x[2], 0.0))
+    assert free_rigid_motions(box, [(base_facets, (0.0, 0.0, 0.0))]) == []
+    assert free_rigid_motions(box, [(base_facets, (None, None, 0.0))]) == [
+        "translation in x", "translation in y", "rotation about the z axis"]
+    # 2D: x and y held on the left side only near its lower end: all held
+    square = mesh.create_unit_square(MPI.COMM_WORLD, 4, 4)
+    left = mesh.locate_entities_boundary(square, 1, lambda x: np.isclose(x[0], 0.0))
+    assert free_rigid_motions(square, [(left, (0.0, 0.0))]) == []
+    # x held on the left side only: y translation free, rotation held
+    assert free_rigid_motions(square, [(left, (0.0, None))]) == ["translation in y"]
+    # y held on the left side only: rotation about a point of that side is free
+    free = free_rigid_motions(square, [(left, (None, 0.0))])
+    assert free == ["translation in x", "rotation in the x-y plane about (0, 0.5)"] or (
+        len(free) == 2 and "translation in x" in free[0]), free
+
+
+def test_initial_penetration_beyond_facet_size_warns(tmp_path):
+    from fenics_contact.scene.build import SceneWarning
+
+    scene = base()
+    scene["obstacle"]["point"] = [0.0, 0.6]  # base at y = 0: 0.6 inside; h = 0.25
+    scene["dirichlet"][0]["value"] = [0.0, 0.0]
+    with pytest.warns(SceneWarning, match=r"starts 0.6 inside the obstacle, more than the "
+                      r"contact facet size h = 0.25 \(2.4 h\)"):
+        _build(write(tmp_path, scene))
+    scene["obstacle"]["point"] = [0.0, 0.2]  # 0.2 < h: no warning
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", SceneWarning)
+        _build(write(tmp_path, scene))
+
+
+# -- output folders -----------------------------------------------------------------------
+def test_output_folder_that_cannot_be_created_exits_2(tmp_path, capsys):
+    path = write(tmp_path, base())
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    for out, words in [(blocker / "out", "below the file"), (blocker, "an existing file")]:
+        assert main(["run", str(path), "--out", str(out), "--quiet"]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1, err
+        assert f"cannot create output folder {out}: it is {words}" in err
+
+
+def test_output_folder_not_writable(tmp_path, monkeypatch):
+    import tempfile
+
+    from fenics_contact.output.folders import OutputFolderError, prepare_output_folder
+
+    def refuse(*args, **kwargs):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(tempfile, "mkdtemp", refuse)
+    with pytest.raises(OutputFolderError, match=r"cannot write to output folder .*a/b "
+                       r"\(.*: Permission denied\); choose a writable --out"):
+        prepare_output_folder(tmp_path / "a" / "b")
+    assert not (tmp_path / "a").exists()
