@@ -97,7 +97,7 @@ SCHEMA_CASES = [
     ("number-missing", edit(material__E=None), r"\[material\] E is missing: give a number"),
     ("number-type", edit(material__E="big"), r"\[material\] E = 'big': must be a number"),
     ("number-finite", edit(material__E=math.inf), r"\[material\] E = inf: must be finite"),
-    ("number-positive", edit(contact__r=0.0), r"\[contact\] r = 0.0: must be > 0"),
+    ("number-positive", edit(contact__r=0.0), r"\[contact\] r = 0.0: must be finite and > 0"),
     ("integer", edit(solver__steps=0), r"\[solver\] steps = 0: must be an integer >= 1"),
     ("integer-type", edit(solver__max_cutbacks=1.5), r"max_cutbacks = 1.5: must be an integer"),
     ("flag", edit(contact__relative="yes"), r"\[contact\] relative = 'yes': must be true or"),

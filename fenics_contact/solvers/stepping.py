@@ -166,6 +166,8 @@ class RunRecord:
         """Flat row for CSV and tables: fields, totals and r, no histories."""
         d = {k: v for k, v in asdict(self).items() if k not in ("steps", "switches")}
         d.update({k: getattr(self, k) for k in self._DERIVED})
+        if math.isnan(self.error):
+            d["error"] = None  # not measured (no reference)
         d["switches"] = "; ".join(dict.fromkeys(s.split(":")[0] for s in self.switches))
         return d
 
