@@ -244,8 +244,11 @@ class ProblemBase:
                 self.domain.topology.index_map(self.domain.topology.dim).size_local,
                 dtype=np.int32,
             )
-        values = self._det_expr.eval(self.domain, self._det_cells)
-        per_cell = values.reshape(self._det_cells.size, -1).min(axis=1)
+        if self._det_cells.size:
+            values = self._det_expr.eval(self.domain, self._det_cells)
+            per_cell = values.reshape(self._det_cells.size, -1).min(axis=1)
+        else:  # a rank without cells
+            per_cell = np.zeros(0)
         if per_cell.size:
             worst = int(np.argmin(per_cell))
             local = float(per_cell[worst])
