@@ -68,11 +68,10 @@ def test_kernel_accounts_add_up() -> None:
     assert t.linear_solves == t.jacobians == path.linear_solves == path.iterations
     assert t.residuals == path.iterations + len(path.steps)
     assert min(t.compile_s, t.residual_s, t.jacobian_s, t.setup_s, t.solve_s) > 0
-    # the accounts are disjoint parts of the steps' wall time (compilation happens
-    # before the first step): counting a phase twice would exceed it
+    # the totals are sums of the disjoint phase accounts (a bookkeeping identity;
+    # how the phases compare with wall time is measured in benchmarks/hertz2d.py)
     accounted = t.residual_s + t.jacobian_s + t.setup_s + t.solve_s
     assert t.assembly_s + t.linear_s == pytest.approx(accounted, rel=1e-12)
-    assert 0 < accounted <= sum(s.wall_s for s in path.steps)
 
 
 def test_stopwatch_measures_and_differences_subtract() -> None:
