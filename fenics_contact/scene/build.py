@@ -200,13 +200,21 @@ def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProbl
         r=scene.contact.r, relative=scene.contact.relative,
         quadrature=scene.contact.quadrature,  # type: ignore[arg-type]
     )
-    return ContactProblem(
+    args = (
         body.domain,
         material(scene.law, scene.E, scene.nu),
         obstacle,
         contact_facets(scene, body, obstacle),
         settings,
-        prescribed=prescribed,
-        tractions=tractions,
-        obstacle_motion=scene.obstacle.motion,
     )
+    options: dict[str, Any] = {
+        "prescribed": prescribed,
+        "tractions": tractions,
+        "obstacle_motion": scene.obstacle.motion,
+        "obstacle_schedule": scene.obstacle.schedule or None,
+    }
+    if scene.contact.mu is not None:
+        from fenics_contact.model.friction import FrictionalContactProblem
+
+        return FrictionalContactProblem(*args, mu=scene.contact.mu, **options)
+    return ContactProblem(*args, **options)

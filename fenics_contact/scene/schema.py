@@ -17,8 +17,12 @@ Layout (units are the user's; be consistent)::
                  optional x/y/z = [min, max] bounds on facet midpoints
     [[traction]]  tag, value = [tx, ty(, tz)]  (per reference area)
     [obstacle]   type = "plane" (point, normal) | "ball" (centre, radius,
-                 inside), motion = [...] (displacement at load factor 1)
-    [contact]    tag, or detect = true with margin; r, relative, quadrature
+                 inside), motion = [...] (displacement at load factor 1), or
+                 schedule = [[t, dx, dy(, dz)], ...] (piecewise-linear
+                 displacement against the load factor t, rows from t = 0 to
+                 t = 1: a load path in phases, e.g. press then slide)
+    [contact]    tag, or detect = true with margin; r, relative, quadrature,
+                 mu (Coulomb friction coefficient, >= 0; absent: frictionless)
     [solver]     method, steps, max_iterations, atol, rtol, max_cutbacks,
                  predictor = "extrapolate" (start a step from the linear
                  extrapolation of the last two) | "previous",
@@ -47,6 +51,9 @@ from fenics_contact.solvers import STRATEGIES
 METHODS = tuple(STRATEGIES)
 #: Fields the XDMF output can hold.
 FIELDS = ("displacement", "contact_pressure", "gap", "active", "von_mises")
+#: Further fields of a frictional scene (tangential traction, slip increment,
+#: 0 open / 1 stick / 2 slip per node).
+FRICTION_FIELDS = ("tangential_traction", "slip", "stick_slip")
 GENERATOR_TAGS: dict[str, dict[str, int]] = {
     "rectangle": {"left": 1, "right": 2, "bottom": 3, "top": 4},
     "box": {"xmin": 1, "xmax": 2, "ymin": 3, "ymax": 4, "zmin": 5, "zmax": 6},
@@ -60,8 +67,8 @@ _SCHEMA: dict[str, set[str]] = {
     "material": {"law", "E", "nu", "kinematics"},
     "dirichlet": {"tag", "value", "x", "y", "z"},
     "traction": {"tag", "value"},
-    "obstacle": {"type", "point", "normal", "centre", "radius", "inside", "motion"},
-    "contact": {"tag", "detect", "margin", "r", "relative", "quadrature"},
+    "obstacle": {"type", "point", "normal", "centre", "radius", "inside", "motion", "schedule"},
+    "contact": {"tag", "detect", "margin", "r", "relative", "quadrature", "mu"},
     "solver": {"method", "steps", "max_iterations", "atol", "rtol", "max_cutbacks", "predictor",
                "linear_solver"},
     "output": {"fields", "pictures"},
@@ -104,6 +111,7 @@ class ObstacleSpec:
     radius: float = 0.0
     inside: bool = False
     motion: tuple[float, ...] = ()
+    schedule: tuple[tuple[float, ...], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -116,6 +124,7 @@ class ContactSpec:
     r: float = 1.0
     relative: bool = True
     quadrature: str = "nodal"
+    mu: float | None = None
 
 
 @dataclass(frozen=True)
@@ -336,15 +345,47 @@ def _boundary(reader: _Reader, dimension: int, allow_free: bool) -> BoundarySpec
     )
 
 
+def _schedule(reader: _Reader, dimension: int) -> tuple[tuple[float, ...], ...]:
+    """Rows [t, offset...] with t strictly increasing from 0 to 1."""
+    if "schedule" not in reader.table:
+        return ()
+    if "motion" in reader.table:
+        raise reader.fail("schedule", "give either 'motion' or 'schedule', not both.")
+    rows = reader.table["schedule"]
+    fix = f"give rows [t, {', '.join('d' + 'xyz'[i] for i in range(dimension))}]"
+    if not isinstance(rows, list) or len(rows) < 2:
+        raise reader.fail("schedule", f"must be a list of at least two rows; {fix}.")
+    out = []
+    for row in rows:
+        if (
+            not isinstance(row, list) or len(row) != dimension + 1
+            or not all(isinstance(v, int | float) and not isinstance(v, bool)
+                       and math.isfinite(v) for v in row)
+        ):
+            raise reader.fail("schedule", f"row {row!r} is not {dimension + 1} finite numbers; {fix}.")
+        out.append(tuple(float(v) for v in row))
+    times = [row[0] for row in out]
+    if times[0] != 0.0 or times[-1] != 1.0 or any(b <= a for a, b in zip(times, times[1:])):
+        raise reader.fail(
+            "schedule", f"load factors {times} must increase strictly from 0 to 1."
+        )
+    return tuple(out)
+
+
 def _obstacle(reader: _Reader, dimension: int) -> ObstacleSpec:
     kind = reader.choice("type", ("plane", "ball"))
-    motion = reader.vector("motion", dimension, default=(0.0,) * dimension)
+    schedule = _schedule(reader, dimension)
+    motion = (
+        schedule[-1][1:] if schedule
+        else reader.vector("motion", dimension, default=(0.0,) * dimension)
+    )
     if kind == "plane":
         normal = reader.vector("normal", dimension)
         if all(v == 0 for v in normal):
             raise reader.fail("normal", "must be a nonzero vector (the body's side).")
         return ObstacleSpec(
-            "plane", point=reader.vector("point", dimension), normal=normal, motion=motion
+            "plane", point=reader.vector("point", dimension), normal=normal, motion=motion,
+            schedule=schedule,
         )
     return ObstacleSpec(
         "ball",
@@ -352,6 +393,7 @@ def _obstacle(reader: _Reader, dimension: int) -> ObstacleSpec:
         radius=reader.number("radius", positive=True),
         inside=reader.flag("inside", False),
         motion=motion,
+        schedule=schedule,
     )
 
 
@@ -369,7 +411,18 @@ def _contact(reader: _Reader) -> ContactSpec:
         r=reader.number("r", 1.0, positive=True),
         relative=reader.flag("relative", True),
         quadrature=reader.choice("quadrature", ("nodal", "gauss"), default="nodal"),
+        mu=_friction(reader),
     )
+
+
+def _friction(reader: _Reader) -> float | None:
+    """The Coulomb coefficient: absent (frictionless) or a finite number >= 0."""
+    if "mu" not in reader.table:
+        return None
+    mu = reader.number("mu")
+    if mu < 0:
+        raise reader.fail("mu", "the friction coefficient must be >= 0 (0: frictionless).")
+    return mu
 
 
 def _solver(reader: _Reader) -> SolverSpec:
@@ -410,9 +463,18 @@ def load_scene(path: Path | str) -> Scene:
             "kinematics", f"does not match law = {law!r}; small strain is law = 'linear'."
         )
     output = _table(path, data, "output", required=False)
-    fields = output.table.get("fields", list(FIELDS))
-    if not isinstance(fields, list) or any(f not in FIELDS for f in fields):
-        raise output.fail("fields", f"choose from {', '.join(FIELDS)}.")
+    contact = _contact(_table(path, data, "contact"))
+    allowed = FIELDS + FRICTION_FIELDS if contact.mu is not None else FIELDS
+    fields = output.table.get("fields", list(allowed))
+    if not isinstance(fields, list) or any(f not in allowed for f in fields):
+        hint = "" if contact.mu is not None else " (friction fields need [contact] mu)"
+        raise output.fail("fields", f"choose from {', '.join(allowed)}{hint}.")
+    obstacle = _obstacle(_table(path, data, "obstacle"), dimension)
+    if obstacle.schedule and contact.detect:
+        raise SceneError(
+            f"{path.name}: [contact] detect = true follows the obstacle's straight motion; "
+            "with [obstacle] schedule give the candidate facets by [contact] tag."
+        )
     return Scene(
         path=path,
         name=str(head.table.get("name", path.stem)),
@@ -424,8 +486,8 @@ def load_scene(path: Path | str) -> Scene:
         nu=_poisson(material),
         dirichlet=tuple(_boundary(r, dimension, True) for r in _array(path, data, "dirichlet")),
         tractions=tuple(_boundary(r, dimension, False) for r in _array(path, data, "traction")),
-        obstacle=_obstacle(_table(path, data, "obstacle"), dimension),
-        contact=_contact(_table(path, data, "contact")),
+        obstacle=obstacle,
+        contact=contact,
         solver=_solver(_table(path, data, "solver", required=False)),
         fields=tuple(fields),
         pictures=output.flag("pictures", True),

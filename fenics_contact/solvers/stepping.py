@@ -1,6 +1,9 @@
 """Load stepping with step cut-back.
 
-The load factor goes from 0 to 1 in equal increments. A failed increment is
+The load factor goes from 0 to 1 in equal increments. Before each
+increment the problem commits its last converged state (``problem.commit()``:
+the start of the slip increment for friction, a no-op without), so the step's
+diagnostics and outputs still see the increment just solved. A failed increment is
 undone (displacement and multiplier restored) and retried with half the
 increment, up to ``max_cutbacks`` times in a row; past that the path stops
 with the failing status, and the steps already converged are kept (the
@@ -35,6 +38,10 @@ class StepRecord:
         max_penetration: largest nodal penetration (length).
         contact_force: total normal contact force (force, per thickness in 2D).
         wall_s: wall-clock time of the step (seconds).
+        tangential_force: magnitude of the total tangential contact force
+            (force, per thickness in 2D; 0 without friction).
+        stick_count: contact nodes that stick (0 without friction).
+        slip_count: contact nodes that slip (0 without friction).
     """
 
     step: int
@@ -49,6 +56,9 @@ class StepRecord:
     max_penetration: float = 0.0
     contact_force: float = 0.0
     wall_s: float = 0.0
+    tangential_force: float = 0.0
+    stick_count: int = 0
+    slip_count: int = 0
 
     def to_dict(self) -> dict:
         """Plain-data view for JSON."""
@@ -223,6 +233,9 @@ def solve_load_path(
         halvings = 0
         while t < target - 1e-14:
             t_try = min(t + increment, target)
+            # history-dependent terms (friction) take the last converged state as
+            # the start of the increment; idempotent after a restore
+            problem.commit()
             saved = problem.snapshot()
             problem.set_load(t_try)
             result = strategy.solve()
@@ -246,6 +259,8 @@ def solve_load_path(
         step.active_count = state.active_count
         step.max_penetration = state.max_penetration
         step.contact_force = state.contact_force
+        for name in ("tangential_force", "stick_count", "slip_count"):  # frictional states
+            setattr(step, name, getattr(state, name, getattr(step, name)))
         run.steps.append(step)
         run.wall_s += time.perf_counter() - run_start
         run_start = time.perf_counter()
