@@ -180,6 +180,10 @@ class FrictionalContactProblem(ContactProblem):
         self._slip_forms = [self.surface.nodal_form(self.slip[i]) for i in range(k)]
         self._y_forms = [self.surface.nodal_form(self.trial_traction[i]) for i in range(k)]
         self._rho_form = self.surface.nodal_form(self.coulomb_radius)
+        self._global_forms = [
+            [self.surface.nodal_form(-(self.tangents * self.traction_t)[i]) for i in range(gdim)],
+            [self.surface.nodal_form((self.tangents * self.slip)[i]) for i in range(gdim)],
+        ]
         force = self.tangents * self.traction_t
         self._tforce_forms = [
             fem.form(force[i] * self.surface.ds, entity_maps=self.surface.entity_maps)
@@ -304,8 +308,20 @@ class FrictionalContactProblem(ContactProblem):
         """Fingerprint of the global open/stick/slip pattern."""
         return tuple(self.comm.allgather(self.node_states().tobytes()))
 
+    def tangential_fields(self) -> tuple[np.ndarray, np.ndarray]:
+        """Owned nodal vectors in global axes, shape (n, gdim) each.
+
+        The tangential traction on the body -T tau (stress) and the slip
+        increment T dg_t of the body relative to the obstacle (length).
+        """
+        traction, slip = (
+            np.column_stack([self.surface.nodal(f) for f in forms])
+            for forms in self._global_forms
+        )
+        return traction, slip
+
     def tangential_force_vector(self) -> np.ndarray:
-        """Global int T tau dA (force; per thickness in 2D): minus the friction force on the body."""
+        """Global int T tau dA (force; per thickness in 2D): minus the friction on the body."""
         return np.array([
             self.comm.allreduce(fem.assemble_scalar(f), op=MPI.SUM) for f in self._tforce_forms
         ])

@@ -20,7 +20,7 @@ from dolfinx import fem, io
 
 from fenics_contact.model.materials import von_mises
 from fenics_contact.model.problem import ContactProblem
-from fenics_contact.scene.schema import FIELDS
+from fenics_contact.scene.schema import FIELDS, FRICTION_FIELDS
 
 
 def _clean(value: object) -> object:
@@ -85,6 +85,19 @@ class SurfaceToBody:
         f.x.array[self.body_dofs] = values
         return f
 
+    def vector_field(self, name: str, values: np.ndarray) -> fem.Function:
+        """A body vector P1 function holding nodal vectors, zero off the surface.
+
+        ``values`` has shape (all local surface dofs, gdim), ghosts included.
+        """
+        gdim = values.shape[1]
+        if getattr(self, "_Wv", None) is None:
+            self._Wv = fem.functionspace(self.W.mesh, ("Lagrange", 1, (gdim,)))
+        f = fem.Function(self._Wv, name=name)
+        for i in range(gdim):
+            f.x.array[self.body_dofs * gdim + i] = values[:, i]
+        return f
+
 
 def flatten_xdmf(path: Path) -> None:
     """Rewrite a DOLFINx XDMF file as one temporal collection with every field per step.
@@ -137,8 +150,12 @@ class StepWriter:
 
     Fields: displacement (P1 vector), contact_pressure, gap and active (P1
     scalars, zero off the contact surface) and von_mises (cell-wise Cauchy
-    von Mises stress). Time is the load factor. DOLFINx rewrites the XDMF
-    index at each write, so completed steps survive a later failure.
+    von Mises stress). With friction also tangential_traction (the
+    tangential traction the obstacle puts on the body, P1 vector, stress),
+    slip (the slip increment of the load step relative to the obstacle, P1
+    vector, length) and stick_slip (0 open, 1 stick, 2 slip). Time is the
+    load factor. DOLFINx rewrites the XDMF index at each write, so completed
+    steps survive a later failure.
     """
 
     def __init__(
@@ -146,9 +163,10 @@ class StepWriter:
     ) -> None:
         if problem.V.ufl_element().embedded_superdegree != 1:
             raise ValueError("XDMF output needs P1 displacement; interpolate higher orders first.")
-        unknown = set(fields) - set(FIELDS)
+        known = FIELDS + FRICTION_FIELDS if hasattr(problem, "lam_t") else FIELDS
+        unknown = set(fields) - set(known)
         if unknown:
-            raise ValueError(f"Unknown output fields {sorted(unknown)}; choose from {FIELDS}.")
+            raise ValueError(f"Unknown output fields {sorted(unknown)}; choose from {known}.")
         if problem.comm.rank == 0:
             path.parent.mkdir(parents=True, exist_ok=True)
         problem.comm.Barrier()
@@ -180,9 +198,19 @@ class StepWriter:
             "gap": state.gap,
             "active": state.active.astype(float),
         }
+        if any(name in FRICTION_FIELDS for name in self.fields):
+            traction, slip = p.tangential_fields()  # type: ignore[attr-defined]
+            surface["stick_slip"] = state.node_state.astype(float)  # type: ignore[attr-defined]
+            vectors = {"tangential_traction": traction, "slip": slip}
         for name in self.fields:
             if name == "displacement":
                 self.file.write_function(p.u, t)
+            elif name in ("tangential_traction", "slip"):
+                local = np.column_stack([
+                    self._surface_field("c", vectors[name][:, i]).x.array[self.mapper.body_dofs]
+                    for i in range(vectors[name].shape[1])
+                ])
+                self.file.write_function(self.mapper.vector_field(name, local), t)
             elif name == "von_mises":
                 assert self._stress is not None
                 self._stress.interpolate(self._stress_expr)

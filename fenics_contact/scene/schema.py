@@ -38,6 +38,7 @@ zmax = 6. Tags may be given by number or by name.
 from __future__ import annotations
 
 import difflib
+import itertools
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -362,10 +363,13 @@ def _schedule(reader: _Reader, dimension: int) -> tuple[tuple[float, ...], ...]:
             or not all(isinstance(v, int | float) and not isinstance(v, bool)
                        and math.isfinite(v) for v in row)
         ):
-            raise reader.fail("schedule", f"row {row!r} is not {dimension + 1} finite numbers; {fix}.")
+            raise reader.fail(
+                "schedule", f"row {row!r} is not {dimension + 1} finite numbers; {fix}."
+            )
         out.append(tuple(float(v) for v in row))
     times = [row[0] for row in out]
-    if times[0] != 0.0 or times[-1] != 1.0 or any(b <= a for a, b in zip(times, times[1:])):
+    rising = all(b > a for a, b in itertools.pairwise(times))
+    if times[0] != 0.0 or times[-1] != 1.0 or not rising:
         raise reader.fail(
             "schedule", f"load factors {times} must increase strictly from 0 to 1."
         )
