@@ -123,7 +123,7 @@ def test_answer_does_not_depend_on_r(gnrm_run):
 
 
 def test_penalty_slides_at_mu_times_its_normal_force():
-    problem, run = solve("penalty", 0.1, cutbacks=4)
+    _, run = solve("penalty", 0.1, cutbacks=4)
     assert run.converged
     assert run.cutbacks <= 2  # measured: one halving where sliding starts
     final = run.steps[-1]

@@ -467,29 +467,35 @@ def load_scene(path: Path | str) -> Scene:
             "kinematics", f"does not match law = {law!r}; small strain is law = 'linear'."
         )
     output = _table(path, data, "output", required=False)
-    contact = _contact(_table(path, data, "contact"))
-    allowed = FIELDS + FRICTION_FIELDS if contact.mu is not None else FIELDS
-    fields = output.table.get("fields", list(allowed))
-    if not isinstance(fields, list) or any(f not in allowed for f in fields):
-        hint = "" if contact.mu is not None else " (friction fields need [contact] mu)"
-        raise output.fail("fields", f"choose from {', '.join(allowed)}{hint}.")
+    fields = output.table.get("fields")
+    mesh_spec = _mesh(path, _table(path, data, "mesh"), dimension)
+    E = material.number("E", positive=True)
+    nu = _poisson(material)
+    dirichlet = tuple(_boundary(r, dimension, True) for r in _array(path, data, "dirichlet"))
+    tractions = tuple(_boundary(r, dimension, False) for r in _array(path, data, "traction"))
     obstacle = _obstacle(_table(path, data, "obstacle"), dimension)
+    contact = _contact(_table(path, data, "contact"))
     if obstacle.schedule and contact.detect:
         raise SceneError(
             f"{path.name}: [contact] detect = true follows the obstacle's straight motion; "
             "with [obstacle] schedule give the candidate facets by [contact] tag."
         )
+    allowed = FIELDS + FRICTION_FIELDS if contact.mu is not None else FIELDS
+    fields = list(allowed) if fields is None else fields
+    if not isinstance(fields, list) or any(f not in allowed for f in fields):
+        hint = "" if contact.mu is not None else " (friction fields need [contact] mu)"
+        raise output.fail("fields", f"choose from {', '.join(allowed)}{hint}.")
     return Scene(
         path=path,
         name=str(head.table.get("name", path.stem)),
         dimension=dimension,
         description=str(head.table.get("description", "")),
-        mesh=_mesh(path, _table(path, data, "mesh"), dimension),
+        mesh=mesh_spec,
         law=law,
-        E=material.number("E", positive=True),
-        nu=_poisson(material),
-        dirichlet=tuple(_boundary(r, dimension, True) for r in _array(path, data, "dirichlet")),
-        tractions=tuple(_boundary(r, dimension, False) for r in _array(path, data, "traction")),
+        E=E,
+        nu=nu,
+        dirichlet=dirichlet,
+        tractions=tractions,
         obstacle=obstacle,
         contact=contact,
         solver=_solver(_table(path, data, "solver", required=False)),
