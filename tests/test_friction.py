@@ -167,3 +167,19 @@ def test_obstacle_follows_its_schedule():
     problem.set_load(0.7)
     assert np.allclose(problem.obstacle.point.value, [0.01, 0.01])
     assert MPI.COMM_WORLD.size >= 1
+
+
+def test_cattaneo_mindlin_stick_zone_of_a_cylinder_on_a_rigid_plane():
+    """Interim check (beta = 0.09, frictionless pressing): c = a sqrt(1 - Q/(mu P))."""
+    from fenics_contact.verification.cattaneo import CattaneoCylinder, solve_cattaneo
+
+    _, zones, iterations = solve_cattaneo(
+        CattaneoCylinder(shift=0.003), press_steps=2, shear_steps=4
+    )
+    assert max(iterations[2:]) <= 3  # shear steps (pressing: 6 each)
+    ratios = [z.Q / (0.3 * z.P) for z in zones]
+    assert ratios == sorted(ratios) and 0.4 < ratios[-1] < 0.6
+    for zone in zones[1:]:  # measured: within 2.4 %, node spacing 2.5-3.4 % of c
+        assert abs(zone.c_error) < 0.05
+        assert zone.traction_error < 0.12  # measured 0.077 ... 0.090
+        assert zone.slip_nodes > 0 and zone.stick_nodes > 0
