@@ -183,3 +183,54 @@ def test_cattaneo_mindlin_stick_zone_of_a_cylinder_on_a_rigid_plane():
         assert abs(zone.c_error) < 0.05
         assert zone.traction_error < 0.12  # measured 0.077 ... 0.090
         assert zone.slip_nodes > 0 and zone.stick_nodes > 0
+
+
+BLOCK_3D = """
+[scene]
+name = "block-3d-friction"
+dimension = 3
+[mesh]
+generator = "box"
+size = [1.0, 1.0, 0.5]
+cells = [4, 4, 2]
+[material]
+law = "svk"
+E = 1000.0
+nu = 0.0
+[[dirichlet]]
+tag = "zmax"
+value = [0.0, 0.0, 0.0]
+[obstacle]
+type = "plane"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+schedule = [[0.0, 0.0, 0.0, 0.0], [0.4, 0.0, 0.0, 0.01], [1.0, 0.012, 0.016, 0.01]]
+[contact]
+tag = "zmin"
+r = 0.1
+mu = 0.3
+"""
+
+
+@pytest.mark.mpi
+def test_block_slides_diagonally_in_3d(tmp_path):
+    """Two tangential components: the friction force opposes the plane's motion (0.6, 0.8)."""
+    path = tmp_path / "block3d.toml"  # each rank has its own tmp_path
+    path.write_text(BLOCK_3D)
+    problem = build_problem(load_scene(path))
+    strategy = make_strategy("gnrm", problem, SolverSettings(atol=1e-8), predictor="previous")
+    run = solve_load_path(strategy, 10, max_cutbacks=0)
+    assert run.converged
+    assert [s.iterations for s in run.steps] == [2, 2, 2, 2, 2, 5, 5, 2, 2, 2]
+    final = run.steps[-1]
+    assert final.slip_count == final.active_count == 25
+    state = problem.contact_state()
+    area = problem.surface.lumped_area
+    comm = problem.comm
+    friction = comm.allreduce(float(area @ np.linalg.norm(state.tangential_traction, axis=1)))
+    limit = comm.allreduce(float(area @ state.coulomb_limit))
+    assert friction == pytest.approx(limit, rel=1e-10)  # every node on its Coulomb circle
+    force = problem.tangential_force_vector()  # T tau summed: minus the friction on the body
+    assert np.allclose(force / np.linalg.norm(force), [-0.6, -0.8, 0.0], atol=1e-3)
+    # nodal slip directions spread by about 0.4 degrees: the resultant is a bit below mu N
+    assert final.tangential_force / (MU * final.contact_force) == pytest.approx(1.0, abs=1e-5)
