@@ -33,7 +33,11 @@ CASES = [  # (nu, h_contact, degree, frictionless pressing)
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=harness.OUT)
+    parser.add_argument("--picture-only", action="store_true", help="only draw the profile")
     args = parser.parse_args()
+    picture(args.out / "cattaneo_traction.png")
+    if args.picture_only:
+        return
     records, rows = [], []
     for nu, h, degree, frictionless in CASES:
         cylinder = CattaneoCylinder(nu=nu, h_contact=h, degree=degree, shift=0.003)
@@ -61,6 +65,52 @@ def main() -> None:
     harness.write("cattaneo_cylinder", {"machine": harness.machine(), "records": records},
                   table, args.out)
     print(table)
+
+
+def picture(path: Path, nu: float = 0.45, h: float = 0.002) -> None:
+    """Nodal tangential traction and Coulomb limit against Cattaneo-Mindlin (last shear step)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from fenics_contact.model.friction import STICK
+    from fenics_contact.verification.cattaneo import analytic_traction
+
+    cylinder = CattaneoCylinder(nu=nu, h_contact=h, shift=0.003)
+    problem, zones, _ = solve_cattaneo(cylinder)
+    zone = zones[-1]
+    state = problem.contact_state()
+    x = problem.nodal_coordinates()[:, 0]
+    order = np.argsort(x)
+    x, closed = x[order], state.pressure[order] < 0
+    tau = np.abs(state.tangential_traction[order, 0])
+    limit = state.coulomb_limit[order]
+    stick = state.node_state[order] == STICK
+    s = np.linspace(-zone.a, zone.a, 401)
+    fig, ax = plt.subplots(figsize=(7, 3.8))
+    ax.plot(s / zone.a, analytic_traction(s, zone.a, zone.c_analytic, zone.p0, cylinder.mu),
+            "k-", lw=1, label="Cattaneo-Mindlin q(x)")
+    ax.plot(s / zone.a, cylinder.mu * zone.p0 * np.sqrt(1 - (s / zone.a) ** 2), "k:", lw=0.8,
+            label="mu p (Hertz fit)")
+    ax.plot(x[closed] / zone.a, limit[closed], "+", color="#888888", label="nodal mu p")
+    ax.plot(x[closed & stick] / zone.a, tau[closed & stick], "o", ms=4, label="|tau|, stick")
+    ax.plot(x[closed & ~stick] / zone.a, tau[closed & ~stick], "x", ms=5, label="|tau|, slip")
+    for sign in (-1, 1):
+        ax.axvline(sign * zone.c_analytic / zone.a, color="k", lw=0.5, ls="--")
+    ax.set_xlabel("x / a")
+    ax.set_ylabel("tangential traction")
+    ax.set_title(
+        f"nu = {nu}, h = {h}: Q/(mu P) = {zone.Q / (cylinder.mu * zone.P):.3f}, "
+        f"c error {100 * zone.c_error:+.1f} %, L2 error {100 * zone.traction_error:.1f} %",
+        fontsize=9,
+    )
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
 
 
 def solve_frictional_press(cylinder: CattaneoCylinder):
