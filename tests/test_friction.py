@@ -234,3 +234,17 @@ def test_block_slides_diagonally_in_3d(tmp_path):
     assert np.allclose(force / np.linalg.norm(force), [-0.6, -0.8, 0.0], atol=1e-3)
     # nodal slip directions spread by about 0.4 degrees: the resultant is a bit below mu N
     assert final.tangential_force / (MU * final.contact_force) == pytest.approx(1.0, abs=1e-5)
+
+
+def test_stability_grid_friction_cases_end_with_a_status():
+    from fenics_contact.studies.stability import friction_grid, run_case
+
+    cases = {c.name: c for c in friction_grid()}
+    assert {"slide-mu0", "slide-mu10", "slide-r1e-8", "slide-r1e12", "slide-reversal"} <= set(
+        cases
+    )
+    plain = run_case(cases["slide-r1e4"], "gnrm", max_iterations=30)
+    assert plain.status == "max_iterations" and plain.steps_completed == PRESS_STEPS
+    rescued = run_case(cases["slide-r1e4"], "auto")
+    assert rescued.status == "converged"
+    assert rescued.steps[-1].tangential_force == pytest.approx(SERIAL_TANGENTIAL_FORCE, rel=1e-8)

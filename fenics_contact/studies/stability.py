@@ -4,7 +4,9 @@ Each case is a scene (:mod:`fenics_contact.verification.bench_scenes`) with one 
 an extreme: r from 1e-8 to 1e12 E/h (on the bar and on the Hertz cylinder),
 E from 1e-3 to 1e12 (displacement loading: forces scale with E), nu up to
 0.4999, 1/10/100 load steps, an initial penetration, grazing start, no
-contact, full contact, a very coarse and a fine mesh.
+contact, full contact, a very coarse and a fine mesh; and the sliding block
+with Coulomb friction (groups ``friction``: mu from 0 to 10 and a load
+reversal at r = 0.1 E/h; ``friction-r``: r from 1e-8 to 1e12 E/h at mu = 0.3).
 
 The stopping test is the same for every method and meaningful for any E:
 atol = max(force_rtol * E h^(d-1), round-off floor at r)
@@ -35,6 +37,7 @@ from fenics_contact.solvers import STRATEGIES, make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.stepping import RunRecord, StepRecord, solve_load_path, start_record
 from fenics_contact.verification.bench_scenes import BarScene, BlockScene, HertzScene
+from fenics_contact.verification.friction_scenes import REVERSAL, SlidingBlock
 
 #: Methods the stability grid runs by default.
 METHODS = tuple(STRATEGIES)
@@ -81,6 +84,20 @@ def full_grid() -> list[StabilityCase]:
         StabilityCase("bar-fine-48x16", "mesh", BarScene(nx=48, ny=16, law="neo-hookean")),
         StabilityCase("bar-fine-48x16-svk", "mesh", BarScene(nx=48, ny=16)),
     ]
+    return cases + friction_grid()
+
+
+def friction_grid() -> list[StabilityCase]:
+    """The sliding block with Coulomb friction: mu 0 ... 10, r extremes, a load reversal."""
+    cases = [
+        StabilityCase(f"slide-mu{mu:g}", "friction", SlidingBlock(mu=mu), 0.1)
+        for mu in (0.0, 0.1, 0.3, 1.0, 10.0)
+    ]
+    cases += [
+        StabilityCase(f"slide-r1e{e}", "friction-r", SlidingBlock(), 10.0**e)
+        for e in range(-8, 13, 4)
+    ]
+    cases += [StabilityCase("slide-reversal", "friction", SlidingBlock(schedule=REVERSAL), 0.1)]
     return cases
 
 
