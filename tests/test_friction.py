@@ -23,7 +23,7 @@ SCENE = Path(__file__).parent.parent / "scenes" / "block_slide_friction.toml"
 MU = 0.3
 PRESS_STEPS = 8  # the plane moves up over load factors 0 ... 0.4 (8 of 20 steps)
 
-#: Serial reference (GNRM, r = 0.1 E/h): iterations per step and final forces.
+#: Serial reference (GNRM, r = 1 E/h, r_t = 0.1 E/h): iterations per step and final forces.
 SERIAL_ITERATIONS = [2] * 8 + [3, 3, 4, 4, 3, 3, 3] + [0] * 5
 SERIAL_NORMAL_FORCE = 19.275879891775713
 SERIAL_TANGENTIAL_FORCE = 5.782763967532714
@@ -34,8 +34,12 @@ def _scene(mu=MU):
     return dataclasses.replace(scene, contact=dataclasses.replace(scene.contact, mu=mu))
 
 
-def solve(method="gnrm", r=0.1, mu=MU, cutbacks=0):
-    problem = build_problem(_scene(mu))
+def solve(method="gnrm", r=1.0, mu=MU, cutbacks=0, tangential_r_max=0.1):
+    scene = _scene(mu)
+    scene = dataclasses.replace(
+        scene, contact=dataclasses.replace(scene.contact, tangential_r_max=tangential_r_max)
+    )
+    problem = build_problem(scene)
     problem.set_r(r, relative=True)
     strategy = make_strategy(
         method, problem, SolverSettings(atol=1e-8, rtol=1e-10, max_iterations=100),
@@ -112,14 +116,23 @@ def test_answer_does_not_depend_on_r(gnrm_run):
     reference, _ = gnrm_run
     u_ref = reference.u.x.array
     scale = np.max(np.abs(u_ref))
-    for method, r in [("gnrm", 1e-3), ("gnrm", 1e-2), ("auto", 1e-2), ("auto", 1.0),
-                      ("auto", 1e2)]:
+    for method, r in [("gnrm", 1e-3), ("gnrm", 1e-2), ("gnrm", 0.1), ("gnrm", 1e2),
+                      ("gnrm", 1e4), ("auto", 1e-2), ("auto", 1e2)]:
         problem, run = solve(method, r)
         assert run.converged, (method, r)
+        if method == "gnrm" and r >= 0.1:  # r_t = 0.1 E/h for all of them
+            assert [s.iterations for s in run.steps] == SERIAL_ITERATIONS
         assert np.max(np.abs(problem.u.x.array - u_ref)) < 1e-8 * scale, (method, r)
         assert run.steps[-1].tangential_force == pytest.approx(
             SERIAL_TANGENTIAL_FORCE, rel=1e-8
         ), (method, r)
+
+
+def test_uncapped_tangential_r_makes_gnrm_stall_where_sliding_starts():
+    """The reason for r_t = min(r, 0.1 E/h): with r_t = r = 1 E/h the stick/slip guess flips."""
+    _, run = solve("gnrm", 1.0, tangential_r_max=None)
+    assert run.status == "max_iterations"
+    assert run.steps_completed == PRESS_STEPS
 
 
 def test_penalty_slides_at_mu_times_its_normal_force():
@@ -243,8 +256,11 @@ def test_stability_grid_friction_cases_end_with_a_status():
     assert {"slide-mu0", "slide-mu10", "slide-r1e-8", "slide-r1e12", "slide-reversal"} <= set(
         cases
     )
-    plain = run_case(cases["slide-r1e4"], "gnrm", max_iterations=30)
-    assert plain.status == "max_iterations" and plain.steps_completed == PRESS_STEPS
-    rescued = run_case(cases["slide-r1e4"], "auto")
-    assert rescued.status == "converged"
-    assert rescued.steps[-1].tangential_force == pytest.approx(SERIAL_TANGENTIAL_FORCE, rel=1e-8)
+    uncapped = run_case(cases["slide-rt=r-r1e4"], "gnrm", max_iterations=30)
+    assert uncapped.status == "max_iterations" and uncapped.steps_completed == PRESS_STEPS
+    for method in ("gnrm", "auto"):
+        record = run_case(cases["slide-r1e4"], method)
+        assert record.status == "converged"
+        assert record.steps[-1].tangential_force == pytest.approx(
+            SERIAL_TANGENTIAL_FORCE, rel=1e-8
+        )

@@ -216,5 +216,8 @@ def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProbl
     if scene.contact.mu is not None:
         from fenics_contact.model.friction import FrictionalContactProblem
 
-        return FrictionalContactProblem(*args, mu=scene.contact.mu, **options)
+        return FrictionalContactProblem(
+            *args, mu=scene.contact.mu, tangential_r_max=scene.contact.tangential_r_max,
+            **options,
+        )
     return ContactProblem(*args, **options)

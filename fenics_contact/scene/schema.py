@@ -22,7 +22,9 @@ Layout (units are the user's; be consistent)::
                  displacement against the load factor t, rows from t = 0 to
                  t = 1: a load path in phases, e.g. press then slide)
     [contact]    tag, or detect = true with margin; r, relative, quadrature,
-                 mu (Coulomb friction coefficient, >= 0; absent: frictionless)
+                 mu (Coulomb friction coefficient, >= 0; absent: frictionless),
+                 tangential_r_max (cap of the tangential parameter r_t =
+                 min(r, tangential_r_max E/h); default 0.1)
     [solver]     method, steps, max_iterations, atol, rtol, max_cutbacks,
                  predictor = "extrapolate" (start a step from the linear
                  extrapolation of the last two) | "previous",
@@ -69,7 +71,8 @@ _SCHEMA: dict[str, set[str]] = {
     "dirichlet": {"tag", "value", "x", "y", "z"},
     "traction": {"tag", "value"},
     "obstacle": {"type", "point", "normal", "centre", "radius", "inside", "motion", "schedule"},
-    "contact": {"tag", "detect", "margin", "r", "relative", "quadrature", "mu"},
+    "contact": {"tag", "detect", "margin", "r", "relative", "quadrature", "mu",
+                "tangential_r_max"},
     "solver": {"method", "steps", "max_iterations", "atol", "rtol", "max_cutbacks", "predictor",
                "linear_solver"},
     "output": {"fields", "pictures"},
@@ -126,6 +129,7 @@ class ContactSpec:
     relative: bool = True
     quadrature: str = "nodal"
     mu: float | None = None
+    tangential_r_max: float = 0.1
 
 
 @dataclass(frozen=True)
@@ -416,6 +420,7 @@ def _contact(reader: _Reader) -> ContactSpec:
         relative=reader.flag("relative", True),
         quadrature=reader.choice("quadrature", ("nodal", "gauss"), default="nodal"),
         mu=_friction(reader),
+        tangential_r_max=reader.number("tangential_r_max", 0.1, positive=True),
     )
 
 

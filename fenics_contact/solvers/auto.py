@@ -51,11 +51,6 @@ class AutoSettings:
 
     Attributes:
         r_window: (low, high) range of the working r, relative to E/h.
-        friction_r_window: the same with Coulomb friction (mu > 0). Measured on
-            the sliding block: plain GNRM converges in 2-5 iterations per step
-            at r <= 0.1 E/h, while at r = 0.3 E/h the stick/slip guess
-            flips sign between iterates (65-81 iterations a step) and at
-            r >= 1 E/h it cycles; the nodal answer is the same for any r.
         continuation_factor: r ratio between continuation rungs (Gauss rule).
         min_damping: smallest line-search step length tried.
         armijo: sufficient-decrease constant of the line search.
@@ -63,7 +58,6 @@ class AutoSettings:
     """
 
     r_window: tuple[float, float] = (1e-2, 1e2)
-    friction_r_window: tuple[float, float] = (1e-3, 1e-1)
     continuation_factor: float = 100.0
     min_damping: float = 1.0 / 64.0
     armijo: float = 1e-4
@@ -112,9 +106,7 @@ class AutoStrategy(NewtonStrategy):
     def working_r(self) -> float:
         """The user's r clamped to the window (absolute, stress per length)."""
         scale = self.problem.stiffness_scale
-        frictional = getattr(self.problem, "friction_coefficient", 0.0) > 0.0
-        window = self.auto.friction_r_window if frictional else self.auto.r_window
-        low, high = (w * scale for w in window)
+        low, high = (w * scale for w in self.auto.r_window)
         return min(max(self.problem.r_absolute, low), high)
 
     def rungs(self) -> list[float]:

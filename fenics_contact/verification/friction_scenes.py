@@ -38,6 +38,7 @@ class SlidingBlock:
         width, height: block size (length).
         E, nu: SVK material (nu = 0: no sideways spreading when pressed).
         steps: load steps.
+        tangential_r_max: cap of r_t relative to E/h (None: r_t = r).
     """
 
     mu: float = 0.3
@@ -49,6 +50,7 @@ class SlidingBlock:
     E: float = 1000.0
     nu: float = 0.0
     steps: int = 20
+    tangential_r_max: float | None = 0.1
 
     @property
     def label(self) -> str:
@@ -73,4 +75,5 @@ class SlidingBlock:
             domain, material("svk", self.E, self.nu), plane, bottom, settings,
             prescribed=[PrescribedDisplacement(top, (0.0, 0.0))],
             obstacle_schedule=self.schedule, mu=self.mu,
+            tangential_r_max=self.tangential_r_max,
         )
