@@ -129,7 +129,7 @@ class ContactSpec:
     relative: bool = True
     quadrature: str = "nodal"
     mu: float | None = None
-    tangential_r_max: float = 0.1
+    tangential_r_max: float | None = 0.1
 
 
 @dataclass(frozen=True)
