@@ -168,6 +168,9 @@ def test_scene_rejects_a_bad_friction_coefficient(tmp_path):
     bad.write_text(text.replace("mu = 0.3", 'mu = "high"'))
     with pytest.raises(SceneError, match=r"\[contact\] mu.*number"):
         load_scene(bad)
+    bad.write_text(text.replace("mu = 0.3", "mu = 0.3\ntangential_r_max = 0.0"))
+    with pytest.raises(SceneError, match=r"\[contact\] tangential_r_max = 0.0: must be > 0"):
+        load_scene(bad)
     bad.write_text(text.replace("[1.0, 0.02, 0.01]]", "[0.9, 0.02, 0.01]]"))
     with pytest.raises(SceneError, match=r"schedule.*from 0 to 1"):
         load_scene(bad)
