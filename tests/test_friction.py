@@ -168,7 +168,7 @@ def test_scene_rejects_a_bad_friction_coefficient(tmp_path):
     bad.write_text(text.replace("mu = 0.3", 'mu = "high"'))
     with pytest.raises(SceneError, match=r"\[contact\] mu.*number"):
         load_scene(bad)
-    bad.write_text(text.replace("mu = 0.3", "mu = 0.3\ntangential_r_max = 0.0"))
+    bad.write_text(text.replace("\nmu = 0.3\n", "\nmu = 0.3\ntangential_r_max = 0.0\n"))
     with pytest.raises(SceneError, match=r"\[contact\] tangential_r_max = 0.0: must be > 0"):
         load_scene(bad)
     bad.write_text(text.replace("[1.0, 0.02, 0.01]]", "[0.9, 0.02, 0.01]]"))
