@@ -267,3 +267,16 @@ def test_stability_grid_friction_cases_end_with_a_status():
         assert record.steps[-1].tangential_force == pytest.approx(
             SERIAL_TANGENTIAL_FORCE, rel=1e-8
         )
+
+
+def test_iterative_linear_solver_takes_both_multipliers_in_one_split():
+    from fenics_contact.solvers.linear import LinearSolverSettings
+
+    problem = build_problem(_scene())
+    strategy = make_strategy(
+        "gnrm", problem, SolverSettings(atol=1e-8, rtol=1e-10), predictor="previous",
+        linear=LinearSolverSettings(kind="iterative"),
+    )
+    run = solve_load_path(strategy, 20, max_cutbacks=0)
+    assert [s.iterations for s in run.steps] == SERIAL_ITERATIONS
+    assert run.steps[-1].tangential_force == pytest.approx(SERIAL_TANGENTIAL_FORCE, rel=1e-8)
