@@ -257,7 +257,7 @@ class FrictionalContactProblem(ContactProblem):
         """Newton on (u, lam_n, lam_t): the frictional GNRM system.
 
         Multiplier blocks: (min(lam_n + r g, 0) - lam_n) mu_n and
-        (P(lam_t + r dg_t) - lam_t) . mu_t, both in force units.
+        (P(lam_t + r_t dg_t) - lam_t) . mu_t, both in force units.
         """
         base = super().augmented_system()
         residual_u = base.residuals[0] + self._tangential_work(self.traction_t)
@@ -277,7 +277,7 @@ class FrictionalContactProblem(ContactProblem):
         return base
 
     def penalty_system(self) -> VariationalSystem:
-        """Penalty in u: normal r/2 min(g, 0)^2, tangential tau = P(lam_t + r dg_t).
+        """Penalty in u: normal r/2 min(g, 0)^2, tangential tau = P(lam_t + r_t dg_t).
 
         The disc radius is mu r max(-g, 0); lam_t holds the traction committed
         at the last converged step (regularised stick, updated by :meth:`commit`).
@@ -313,7 +313,7 @@ class FrictionalContactProblem(ContactProblem):
     def update_multiplier(self) -> None:
         """Uzawa update of both multipliers, evaluated at the same iterate.
 
-        lam_n <- min(lam_n + r g, 0) and lam_t <- P(lam_t + r dg_t).
+        lam_n <- min(lam_n + r g, 0) and lam_t <- P(lam_t + r_t dg_t).
         """
         tau = self._nodal_components(self._tau_forms)
         super().update_multiplier()
