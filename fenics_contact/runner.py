@@ -43,6 +43,7 @@ def _summary(scene: Scene, record: RunRecord) -> dict:
         "E": scene.E,
         "nu": scene.nu,
         "quadrature": scene.contact.quadrature,
+        "mu": scene.contact.mu,
         "predictor": scene.solver.predictor,
         "linear_solver": scene.solver.linear_solver,
         "load_steps": scene.solver.steps,
@@ -141,6 +142,14 @@ def run_scene(
         )
         if comm.rank == 0:
             step_residuals(path.steps, out / "residuals.png", title=scene.name)
+        if scene.contact.mu is not None:
+            from fenics_contact.output.friction_plot import friction_profile
+
+            friction_profile(
+                problem, out / "friction.png",  # type: ignore[arg-type]
+                title=f"{scene.name}: tangential traction, load factor "
+                f"{path.steps[-1].load_factor:g}",
+            )
     return RunOutcome(problem, path, summary, out)
 
 

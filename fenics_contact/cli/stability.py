@@ -68,13 +68,15 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="run every method on extreme cases and record each status",
         description="Run methods on extreme cases (r 1e-8 ... 1e12 E/h, E 1e-3 ... 1e12, "
         "nu up to 0.4999, 1/10/100 load steps, initial penetration, grazing, no and full "
-        "contact, coarse and fine meshes); write stability.csv, stability.json, "
+        "contact, coarse and fine meshes, two deformable bodies, Coulomb friction mu 0 ... 10, "
+        "r extremes and a load reversal with friction); write stability.csv, stability.json, "
         "stability.png and per-run step records under cases/. Exit code 0, or 1 when a "
         "run ended with an error (an exception, not a solver status).",
     )
     cmd.add_argument("--cases", type=_names, default=None,
                      help="comma-separated case names or groups (r, E, nu, steps, start, mesh, "
-                     "two-body-r, two-body-stiffness, two-body-sliding); default: all")
+                     "two-body-r, two-body-stiffness, two-body-sliding, friction, friction-r); "
+                     "default: all")
     cmd.add_argument("--methods", type=methods, default=list(METHODS),
                      help="comma-separated strategies (default penalty,sua,nua,gnrm,auto)")
     cmd.add_argument("--max-iterations", type=int, default=100,

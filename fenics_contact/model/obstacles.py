@@ -41,6 +41,10 @@ class RigidObstacle:
         """The same gap evaluated with numpy on points of shape (n, gdim)."""
         raise NotImplementedError
 
+    def normal_at(self, x: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+        """Unit normal at ``x`` pointing to the body's side (the gradient of the gap)."""
+        raise NotImplementedError
+
 
 class RigidPlane(RigidObstacle):
     """Half-space below a plane through ``point`` with outward unit ``normal``.
@@ -64,6 +68,10 @@ class RigidPlane(RigidObstacle):
     def gap_value(self, x: np.ndarray) -> np.ndarray:
         """Numpy gap."""
         return (x - self.point.value) @ self.normal.value
+
+    def normal_at(self, x: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+        """The plane's unit normal n (the same at every x)."""
+        return self.normal
 
 
 class RigidBall(RigidObstacle):
@@ -96,3 +104,9 @@ class RigidBall(RigidObstacle):
         """Numpy gap."""
         g = np.linalg.norm(x - self.point.value, axis=1) - float(self.radius.value)
         return -g if self.inside else g
+
+    def normal_at(self, x: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+        """Radial unit normal +-(x - c)/|x - c| (minus for a cradle)."""
+        d = x - self.point
+        n = d / ufl.sqrt(ufl.dot(d, d))
+        return -n if self.inside else n

@@ -54,6 +54,28 @@ class SurfaceTraction:
     value: tuple[float, ...]
 
 
+def _schedule(
+    rows: Sequence[Sequence[float]] | None, gdim: int
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """Validate a piecewise-linear obstacle schedule: rows (t, offset...), t from 0 to 1."""
+    if rows is None:
+        return None
+    table = np.asarray(rows, dtype=float)
+    if table.ndim != 2 or table.shape[1] != gdim + 1 or table.shape[0] < 2:
+        raise ValueError(
+            f"An obstacle schedule needs at least two rows of {gdim + 1} numbers "
+            f"(load factor, then the {gdim} offset components); got shape {table.shape}."
+        )
+    times = table[:, 0]
+    if not (np.all(np.isfinite(table)) and times[0] == 0.0 and times[-1] == 1.0
+            and np.all(np.diff(times) > 0)):
+        raise ValueError(
+            f"Obstacle schedule load factors {times.tolist()} must be finite, strictly "
+            "increasing, start at 0 and end at 1."
+        )
+    return times, table[:, 1:]
+
+
 def energy_quadrature_degree(psi: ufl.core.expr.Expr, u: fem.Function, degree: int) -> int:
     """Quadrature degree for the strain energy and its derivatives.
 
@@ -295,6 +317,7 @@ class ContactProblem(ProblemBase):
         prescribed: Sequence[PrescribedDisplacement] = (),
         tractions: Sequence[SurfaceTraction] = (),
         obstacle_motion: Sequence[float] | None = None,
+        obstacle_schedule: Sequence[Sequence[float]] | None = None,
         degree: int = 1,
     ) -> None:
         gdim = domain.geometry.dim
@@ -323,6 +346,7 @@ class ContactProblem(ProblemBase):
         self._motion = (
             np.zeros(gdim) if obstacle_motion is None else np.asarray(obstacle_motion, float)
         )
+        self._schedule = _schedule(obstacle_schedule, gdim)
         self._bc_constants: list[tuple[fem.Constant, float]] = []
         self.bcs = self._dirichlet(prescribed)
         self._traction_constants: list[tuple[fem.Constant, np.ndarray]] = []
@@ -362,7 +386,17 @@ class ContactProblem(ProblemBase):
             const.value = t * value
         for const, value in self._traction_constants:
             const.value[:] = t * value
-        self.obstacle.translate_to(t * self._motion)
+        self.obstacle.translate_to(self.obstacle_offset(t))
+
+    def obstacle_offset(self, t: float) -> np.ndarray:
+        """Obstacle displacement at load factor t: t * motion, or the schedule interpolated."""
+        if self._schedule is None:
+            return t * self._motion
+        times, offsets = self._schedule
+        return np.array([np.interp(t, times, offsets[:, i]) for i in range(offsets.shape[1])])
+
+    def commit(self) -> None:
+        """Accept the current state as converged (history-dependent terms; none here)."""
 
     def _external_work(self, tractions: Sequence[SurfaceTraction]) -> ufl.Form | None:
         if not tractions:

@@ -80,3 +80,16 @@ class SurfaceToBody:
         f.x.array[self.body_dofs] = values
         return f
 
+    def vector_field(self, name: str, values: np.ndarray) -> fem.Function:
+        """A body vector P1 function holding nodal vectors, zero off the surface.
+
+        ``values`` has shape (all local surface dofs, gdim), ghosts included.
+        """
+        gdim = values.shape[1]
+        if getattr(self, "_Wv", None) is None:
+            self._Wv = fem.functionspace(self.W.mesh, ("Lagrange", 1, (gdim,)))
+        f = fem.Function(self._Wv, name=name)
+        for i in range(gdim):
+            f.x.array[self.body_dofs * gdim + i] = values[:, i]
+        return f
+

@@ -30,7 +30,7 @@ from dolfinx import fem, io
 from fenics_contact.model.materials import von_mises
 from fenics_contact.model.problem import ContactProblem
 from fenics_contact.output.io import SurfaceToBody
-from fenics_contact.scene.schema import FIELDS
+from fenics_contact.scene.schema import FIELDS, FRICTION_FIELDS
 
 _STEP = re.compile(r"step_(\d{4,})\.(h5|xdmf)$")
 
@@ -116,7 +116,11 @@ class StepWriter:
 
     Fields: displacement (P1 vector), contact_pressure, gap and active (P1
     scalars, zero off the contact surface) and von_mises (cell-wise Cauchy
-    von Mises stress). Time is the load factor. After each step the index
+    von Mises stress). With friction also tangential_traction (the tangential
+    traction the obstacle puts on the body, P1 vector, stress), slip (the
+    slip increment of the load step relative to the obstacle, P1 vector,
+    length) and stick_slip (0 open, 1 stick, 2 slip). Time is the load
+    factor. After each step the index
     ``path`` (an XDMF temporal collection) names every step written so far.
 
     Args:
@@ -138,9 +142,10 @@ class StepWriter:
     ) -> None:
         if problem.V.ufl_element().embedded_superdegree != 1:
             raise ValueError("XDMF output needs P1 displacement; interpolate higher orders first.")
-        unknown = set(fields) - set(FIELDS)
+        known = FIELDS + FRICTION_FIELDS if hasattr(problem, "lam_t") else FIELDS
+        unknown = set(fields) - set(known)
         if unknown:
-            raise ValueError(f"Unknown output fields {sorted(unknown)}; choose from {FIELDS}.")
+            raise ValueError(f"Unknown output fields {sorted(unknown)}; choose from {known}.")
         self.problem = problem
         self.path = path
         self.folder = step_folder(path)
@@ -203,6 +208,14 @@ class StepWriter:
         self._q.x.scatter_forward()
         return self.mapper.field(name, self._q.x.array)
 
+    def _surface_vector(self, name: str, values: np.ndarray) -> fem.Function:
+        """Nodal vectors (surface dofs x gdim) as a body P1 vector field."""
+        local = np.column_stack([
+            self._surface_field("c", values[:, i]).x.array[self.mapper.body_dofs]
+            for i in range(values.shape[1])
+        ])
+        return self.mapper.vector_field(name, local)
+
     def write(self, t: float) -> None:
         """Write the current fields at load factor ``t`` as the next step (collective)."""
         p = self.problem
@@ -212,6 +225,11 @@ class StepWriter:
             "gap": state.gap,
             "active": state.active.astype(float),
         }
+        vectors: dict[str, np.ndarray] = {}
+        if any(name in FRICTION_FIELDS for name in self.fields):
+            traction, slip = p.tangential_fields()  # type: ignore[attr-defined]
+            surface["stick_slip"] = state.node_state.astype(float)  # type: ignore[attr-defined]
+            vectors = {"tangential_traction": traction, "slip": slip}
         step_xdmf = self.folder / f"{_step_name(self.step)}.xdmf"
         with io.XDMFFile(p.comm, str(step_xdmf), "w") as file:
             file.write_mesh(p.domain)
@@ -226,6 +244,8 @@ class StepWriter:
                         else:
                             self._stress.interpolate(expr, cells0=cells)
                     file.write_function(self._stress, t)
+                elif name in vectors:
+                    file.write_function(self._surface_vector(name, vectors[name]), t)
                 else:
                     file.write_function(self._surface_field(name, surface[name]), t)
             if self._body_id is not None:

@@ -302,16 +302,28 @@ def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProbl
         r=scene.contact.r, relative=scene.contact.relative,
         quadrature=scene.contact.quadrature,  # type: ignore[arg-type]
     )
-    problem = ContactProblem(
+    args = (
         body.domain,
         material(scene.law, scene.E, scene.nu),
         obstacle,
         contact_facets(scene, body, obstacle),
         settings,
-        prescribed=prescribed,
-        tractions=tractions,
-        obstacle_motion=scene.obstacle.motion,
     )
+    options: dict[str, Any] = {
+        "prescribed": prescribed,
+        "tractions": tractions,
+        "obstacle_motion": scene.obstacle.motion,
+        "obstacle_schedule": scene.obstacle.schedule or None,
+    }
+    if scene.contact.mu is not None:
+        from fenics_contact.model.friction import FrictionalContactProblem
+
+        problem: ContactProblem = FrictionalContactProblem(
+            *args, mu=scene.contact.mu, tangential_r_max=scene.contact.tangential_r_max,
+            **options,
+        )
+    else:
+        problem = ContactProblem(*args, **options)
     warn_initial_penetration(scene, problem)
     return problem
 

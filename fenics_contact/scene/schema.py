@@ -17,8 +17,14 @@ Layout (units are the user's; be consistent)::
                  optional x/y/z = [min, max] bounds on facet midpoints
     [[traction]]  tag, value = [tx, ty(, tz)]  (per reference area)
     [obstacle]   type = "plane" (point, normal) | "ball" (centre, radius,
-                 inside), motion = [...] (displacement at load factor 1)
-    [contact]    tag, or detect = true with margin; r, relative, quadrature
+                 inside), motion = [...] (displacement at load factor 1), or
+                 schedule = [[t, dx, dy(, dz)], ...] (piecewise-linear
+                 displacement against the load factor t, rows from t = 0 to
+                 t = 1: a load path in phases, e.g. press then slide)
+    [contact]    tag, or detect = true with margin; r, relative, quadrature,
+                 mu (Coulomb friction coefficient, >= 0; absent: frictionless),
+                 tangential_r_max (cap of the tangential parameter r_t =
+                 min(r, tangential_r_max E/h); default 0.1)
     [solver]     method, steps, max_iterations, atol, rtol, max_cutbacks,
                  predictor = "extrapolate" (start a step from the linear
                  extrapolation of the last two) | "previous",
@@ -49,6 +55,9 @@ from fenics_contact.solvers import STRATEGIES
 METHODS = tuple(STRATEGIES)
 #: Fields the XDMF output can hold.
 FIELDS = ("displacement", "contact_pressure", "gap", "active", "von_mises")
+#: Further fields of a frictional scene (tangential traction, slip increment,
+#: 0 open / 1 stick / 2 slip per node).
+FRICTION_FIELDS = ("tangential_traction", "slip", "stick_slip")
 GENERATOR_TAGS: dict[str, dict[str, int]] = {
     "rectangle": {"left": 1, "right": 2, "bottom": 3, "top": 4},
     "box": {"xmin": 1, "xmax": 2, "ymin": 3, "ymax": 4, "zmin": 5, "zmax": 6},
@@ -64,8 +73,9 @@ _SCHEMA: dict[str, set[str]] = {
     "material": {"law", "E", "nu", "kinematics"},
     "dirichlet": {"tag", "value", "x", "y", "z", "path"},
     "traction": {"tag", "value"},
-    "obstacle": {"type", "point", "normal", "centre", "radius", "inside", "motion"},
-    "contact": {"tag", "detect", "margin", "r", "relative", "quadrature"},
+    "obstacle": {"type", "point", "normal", "centre", "radius", "inside", "motion", "schedule"},
+    "contact": {"tag", "detect", "margin", "r", "relative", "quadrature", "mu",
+                "tangential_r_max"},
     "solver": {"method", "steps", "max_iterations", "atol", "rtol", "max_cutbacks", "predictor",
                "linear_solver"},
     "output": {"fields", "pictures"},
@@ -135,6 +145,7 @@ class ObstacleSpec:
     radius: float = 0.0
     inside: bool = False
     motion: tuple[float, ...] = ()
+    schedule: tuple[tuple[float, ...], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -147,6 +158,8 @@ class ContactSpec:
     r: float = 1.0
     relative: bool = True
     quadrature: str = "nodal"
+    mu: float | None = None
+    tangential_r_max: float | None = 0.1
 
 
 @dataclass(frozen=True)
@@ -457,15 +470,50 @@ def _pairs(path: Path, data: dict[str, Any]) -> tuple[PairSpec, ...]:
     return tuple(out)
 
 
+def _schedule(reader: _Reader, dimension: int) -> tuple[tuple[float, ...], ...]:
+    """Rows [t, offset...] with t strictly increasing from 0 to 1."""
+    if "schedule" not in reader.table:
+        return ()
+    if "motion" in reader.table:
+        raise reader.fail("schedule", "give either 'motion' or 'schedule', not both.")
+    rows = reader.table["schedule"]
+    fix = f"give rows [t, {', '.join('d' + 'xyz'[i] for i in range(dimension))}]"
+    if not isinstance(rows, list) or len(rows) < 2:
+        raise reader.fail("schedule", f"must be a list of at least two rows; {fix}.")
+    out = []
+    for row in rows:
+        if (
+            not isinstance(row, list) or len(row) != dimension + 1
+            or not all(isinstance(v, int | float) and not isinstance(v, bool)
+                       and math.isfinite(v) for v in row)
+        ):
+            raise reader.fail(
+                "schedule", f"row {row!r} is not {dimension + 1} finite numbers; {fix}."
+            )
+        out.append(tuple(float(v) for v in row))
+    times = [row[0] for row in out]
+    rising = all(b > a for a, b in itertools.pairwise(times))
+    if times[0] != 0.0 or times[-1] != 1.0 or not rising:
+        raise reader.fail(
+            "schedule", f"load factors {times} must increase strictly from 0 to 1."
+        )
+    return tuple(out)
+
+
 def _obstacle(reader: _Reader, dimension: int) -> ObstacleSpec:
     kind = reader.choice("type", ("plane", "ball"))
-    motion = reader.vector("motion", dimension, default=(0.0,) * dimension)
+    schedule = _schedule(reader, dimension)
+    motion = (
+        schedule[-1][1:] if schedule
+        else reader.vector("motion", dimension, default=(0.0,) * dimension)
+    )
     if kind == "plane":
         normal = reader.vector("normal", dimension)
         if all(v == 0 for v in normal):
             raise reader.fail("normal", "must be a nonzero vector (the body's side).")
         return ObstacleSpec(
-            "plane", point=reader.vector("point", dimension), normal=normal, motion=motion
+            "plane", point=reader.vector("point", dimension), normal=normal, motion=motion,
+            schedule=schedule,
         )
     return ObstacleSpec(
         "ball",
@@ -473,6 +521,7 @@ def _obstacle(reader: _Reader, dimension: int) -> ObstacleSpec:
         radius=reader.number("radius", positive=True),
         inside=reader.flag("inside", False),
         motion=motion,
+        schedule=schedule,
     )
 
 
@@ -490,6 +539,8 @@ def _contact(reader: _Reader) -> ContactSpec:
         r=_contact_r(reader),
         relative=reader.flag("relative", True),
         quadrature=reader.choice("quadrature", ("nodal", "gauss"), default="nodal"),
+        mu=_friction(reader),
+        tangential_r_max=reader.number("tangential_r_max", 0.1, positive=True),
     )
 
 
@@ -500,6 +551,16 @@ def _contact_r(reader: _Reader) -> float:
     if problem is not None:
         raise reader.fail("r", problem)
     return r
+
+
+def _friction(reader: _Reader) -> float | None:
+    """The Coulomb coefficient: absent (frictionless) or a finite number >= 0."""
+    if "mu" not in reader.table:
+        return None
+    mu = reader.number("mu")
+    if mu < 0:
+        raise reader.fail("mu", "the friction coefficient must be >= 0 (0: frictionless).")
+    return mu
 
 
 def _solver(reader: _Reader) -> SolverSpec:
@@ -549,22 +610,35 @@ def load_scene(path: Path | str) -> Scene:
         )
     E, nu = _elastic_constants(material)
     output = _table(path, data, "output", required=False)
-    fields = output.table.get("fields", list(FIELDS))
-    if not isinstance(fields, list) or any(f not in FIELDS for f in fields):
-        raise output.fail("fields", f"choose from {', '.join(FIELDS)}.")
+    fields = output.table.get("fields")
+    mesh_spec = _mesh(path, _table(path, data, "mesh"), dimension)
+    dirichlet = tuple(_boundary(r, dimension, True) for r in _array(path, data, "dirichlet"))
+    tractions = tuple(_boundary(r, dimension, False) for r in _array(path, data, "traction"))
+    obstacle = _obstacle(_table(path, data, "obstacle"), dimension)
+    contact = _contact(_table(path, data, "contact"))
+    if obstacle.schedule and contact.detect:
+        raise SceneError(
+            f"{path.name}: [contact] detect = true follows the obstacle's straight motion; "
+            "with [obstacle] schedule give the candidate facets by [contact] tag."
+        )
+    allowed = FIELDS + FRICTION_FIELDS if contact.mu is not None else FIELDS
+    fields = list(allowed) if fields is None else fields
+    if not isinstance(fields, list) or any(f not in allowed for f in fields):
+        hint = "" if contact.mu is not None else " (friction fields need [contact] mu)"
+        raise output.fail("fields", f"choose from {', '.join(allowed)}{hint}.")
     return Scene(
         path=path,
         name=str(head.table.get("name", path.stem)),
         dimension=dimension,
         description=str(head.table.get("description", "")),
-        mesh=_mesh(path, _table(path, data, "mesh"), dimension),
+        mesh=mesh_spec,
         law=law,
         E=E,
         nu=nu,
-        dirichlet=tuple(_boundary(r, dimension, True) for r in _array(path, data, "dirichlet")),
-        tractions=tuple(_boundary(r, dimension, False) for r in _array(path, data, "traction")),
-        obstacle=_obstacle(_table(path, data, "obstacle"), dimension),
-        contact=_contact(_table(path, data, "contact")),
+        dirichlet=dirichlet,
+        tractions=tractions,
+        obstacle=obstacle,
+        contact=contact,
         solver=_solver(_table(path, data, "solver", required=False)),
         fields=tuple(fields),
         pictures=output.flag("pictures", True),

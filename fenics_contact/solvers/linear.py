@@ -182,9 +182,13 @@ def configure_ksp(
         pc.setType("gamg")
         ksp.setFromOptions()
         return (near_null,)
-    if len(spaces) != 2:
-        raise ValueError(f"The iterative solver handles 1 or 2 blocks, got {len(spaces)}.")
-    is_u, is_lam = block_index_sets(A, spaces)
+    is_u = block_index_sets(A, spaces)[0]
+    # every multiplier block (normal, and tangential with friction) in one split:
+    # they follow the displacement rows contiguously on each rank
+    first = A.getOwnershipRange()[0] + is_u.getLocalSize()
+    is_lam = PETSc.IS().createStride(
+        A.getOwnershipRange()[1] - first, first=first, step=1, comm=A.getComm()
+    )
     # PCFIELDSPLIT hands a near-null space composed on a split's IS to its sub-matrix.
     is_u.compose("nearnullspace", near_null)
     pc.setType("fieldsplit")

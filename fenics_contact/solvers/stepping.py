@@ -1,6 +1,9 @@
 """Load stepping with step cut-back.
 
-The load factor goes from 0 to 1 in equal increments. A failed increment is
+The load factor goes from 0 to 1 in equal increments. Before each
+increment the problem commits its last converged state (``problem.commit()``:
+the start of the slip increment for friction, a no-op without), so the step's
+diagnostics and outputs still see the increment just solved. A failed increment is
 undone (displacement and multiplier restored) and retried with half the
 increment, up to ``max_cutbacks`` times in a row, and never below the step's
 increment / 2**max_cutbacks (a limit the load cannot pass, such as inverted
@@ -46,6 +49,10 @@ class StepRecord:
             undeformed; <= 0 means inverted elements).
         worst_cell: reference midpoint of the cell holding ``min_det_F``.
         message: why the step failed (empty when it converged).
+        tangential_force: magnitude of the total tangential contact force
+            (force, per thickness in 2D; 0 without friction).
+        stick_count: contact nodes that stick (0 without friction).
+        slip_count: contact nodes that slip (0 without friction).
     """
 
     step: int
@@ -63,6 +70,9 @@ class StepRecord:
     min_det_F: float = 1.0
     worst_cell: tuple[float, float, float] = (0.0, 0.0, 0.0)
     message: str = ""
+    tangential_force: float = 0.0
+    stick_count: int = 0
+    slip_count: int = 0
 
     def to_dict(self) -> dict:
         """Plain-data view for JSON."""
@@ -257,6 +267,9 @@ def solve_load_path(
         smallest = increment / 2**max_cutbacks
         while t < target - 1e-14:
             t_try = min(t + increment, target)
+            # history-dependent terms (friction) take the last converged state as
+            # the start of the increment; idempotent after a restore
+            problem.commit()
             saved = problem.snapshot()
             problem.set_load(t_try)
             result = strategy.solve()
@@ -286,6 +299,8 @@ def solve_load_path(
         step.active_count = state.active_count
         step.max_penetration = state.max_penetration
         step.contact_force = state.contact_force
+        for name in ("tangential_force", "stick_count", "slip_count"):  # frictional states
+            setattr(step, name, getattr(state, name, getattr(step, name)))
         run.steps.append(step)
         run.wall_s += time.perf_counter() - run_start
         run_start = time.perf_counter()

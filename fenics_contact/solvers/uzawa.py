@@ -28,9 +28,12 @@ class UzawaBase(NewtonStrategy):
 
     def __init__(self, problem: ContactProblem, settings: SolverSettings, **options: Any) -> None:
         super().__init__(problem, settings, **options)
-        self._complementarity = fem.form(
-            problem.complementarity_residual(), entity_maps=problem.surface.entity_maps
-        )
+        residual = problem.complementarity_residual()
+        # a frictional problem gives the normal and the tangential residual
+        self._complementarity = [
+            fem.form(form, entity_maps=problem.surface.entity_maps)
+            for form in (residual if isinstance(residual, list) else [residual])
+        ]
         self.primal_norm = math.inf
         self.complementarity_norm = math.inf
 
@@ -41,7 +44,10 @@ class UzawaBase(NewtonStrategy):
     def residual_norm(self) -> float:
         """Assemble both residuals; return the norm of the pair."""
         self.primal_norm = self.kernel.assemble_residual()
-        local = assemble_local(self._complementarity)
+        squares = 0.0
+        for form in self._complementarity:
+            local = assemble_local(form)
+            squares += float(local @ local)
         comm = self.problem.comm
-        self.complementarity_norm = math.sqrt(comm.allreduce(float(local @ local), op=MPI.SUM))
+        self.complementarity_norm = math.sqrt(comm.allreduce(squares, op=MPI.SUM))
         return math.hypot(self.primal_norm, self.complementarity_norm)

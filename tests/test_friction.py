@@ -1,0 +1,282 @@
+"""Coulomb friction (Alart-Curnier) against a rigid plane: the sliding block.
+
+The scene presses an elastic block (nu = 0: no sideways spreading) onto a
+rigid plane, then moves the plane sideways past the point of sliding.
+"""
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mpi4py import MPI
+
+from fenics_contact.model.friction import SLIP, STICK, FrictionalContactProblem
+from fenics_contact.scene.build import build_problem
+from fenics_contact.scene.schema import SceneError, load_scene
+from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings
+from fenics_contact.solvers.stepping import solve_load_path
+
+SCENE = Path(__file__).parent.parent / "scenes" / "block_slide_friction.toml"
+MU = 0.3
+PRESS_STEPS = 8  # the plane moves up over load factors 0 ... 0.4 (8 of 20 steps)
+
+#: Serial reference (GNRM, r = 1 E/h, r_t = 0.1 E/h): iterations per step and final forces.
+SERIAL_ITERATIONS = [2] * 8 + [3, 3, 4, 4, 3, 3, 3] + [0] * 5
+SERIAL_NORMAL_FORCE = 19.275879891775713
+SERIAL_TANGENTIAL_FORCE = 5.782763967532714
+
+
+def _scene(mu=MU):
+    scene = load_scene(SCENE)
+    return dataclasses.replace(scene, contact=dataclasses.replace(scene.contact, mu=mu))
+
+
+def solve(method="gnrm", r=1.0, mu=MU, cutbacks=0, tangential_r_max=0.1):
+    scene = _scene(mu)
+    scene = dataclasses.replace(
+        scene, contact=dataclasses.replace(scene.contact, tangential_r_max=tangential_r_max)
+    )
+    problem = build_problem(scene)
+    problem.set_r(r, relative=True)
+    strategy = make_strategy(
+        method, problem, SolverSettings(atol=1e-8, rtol=1e-10, max_iterations=100),
+        predictor="previous",
+    )
+    return problem, solve_load_path(strategy, 20, max_cutbacks=cutbacks)
+
+
+@pytest.fixture(scope="module")
+def gnrm_run():
+    return solve()
+
+
+@pytest.mark.mpi
+def test_sliding_block_obeys_coulomb(gnrm_run):
+    problem, run = gnrm_run
+    assert run.converged
+    steps = run.steps
+    for step in steps[:PRESS_STEPS]:  # pressing: no tangential load, nothing slips
+        assert step.slip_count == 0 and step.stick_count == step.active_count == 21
+        assert step.tangential_force < 1e-12 * step.contact_force
+    ratios = [s.tangential_force / (MU * s.contact_force) for s in steps]
+    for step, ratio in zip(steps, ratios, strict=True):
+        if ratio < 0.6:  # measured: the first node slips at 0.86 mu N
+            assert step.slip_count == 0
+        assert ratio <= 1.0 + 1e-12
+    final = steps[-1]
+    assert final.slip_count == final.active_count == 21
+    assert ratios[-1] == pytest.approx(1.0, rel=1e-8, abs=0)
+    # node by node: |tau| <= mu p where it sticks, = mu p where it slips
+    state = problem.contact_state()
+    tau = np.abs(state.tangential_traction[:, 0])
+    limit = state.coulomb_limit
+    sticks = state.node_state == STICK
+    slips = state.node_state == SLIP
+    assert np.all(tau[sticks] <= limit[sticks])
+    assert np.allclose(tau[slips], limit[slips], rtol=1e-10, atol=0)
+
+
+@pytest.mark.mpi
+def test_parallel_matches_serial_iterations_and_forces(gnrm_run):
+    _, run = gnrm_run
+    assert [s.iterations for s in run.steps] == SERIAL_ITERATIONS
+    final = run.steps[-1]
+    assert final.contact_force == pytest.approx(SERIAL_NORMAL_FORCE, rel=1e-10)
+    assert final.tangential_force == pytest.approx(SERIAL_TANGENTIAL_FORCE, rel=1e-10)
+
+
+def test_friction_costs_at_most_twice_frictionless_with_superlinear_tail(gnrm_run):
+    _, run = gnrm_run
+    _, frictionless = solve(mu=None)
+    assert frictionless.converged
+    worst = max(s.iterations for s in frictionless.steps)
+    assert worst == 2
+    assert all(s.iterations <= 2 * worst for s in run.steps)
+    for step in run.steps[PRESS_STEPS:]:
+        history = step.residuals[-1]
+        if len(history) >= 3:  # the last Newton step gains over three digits
+            assert history[-1] / history[-2] < 1e-3
+
+
+def test_mu_zero_reproduces_frictionless_exactly():
+    p0, run0 = solve(mu=None)
+    p1, run1 = solve(mu=0.0)
+    assert isinstance(p1, FrictionalContactProblem)
+    assert [s.iterations for s in run1.steps] == [s.iterations for s in run0.steps]
+    assert np.max(np.abs(p1.u.x.array - p0.u.x.array)) < 1e-13
+    assert run1.steps[-1].contact_force == pytest.approx(run0.steps[-1].contact_force, rel=1e-13)
+    assert run1.steps[-1].tangential_force == 0.0
+    assert np.all(p1.lam_t.x.array == 0.0)
+
+
+def test_answer_does_not_depend_on_r(gnrm_run):
+    reference, _ = gnrm_run
+    u_ref = reference.u.x.array
+    scale = np.max(np.abs(u_ref))
+    for method, r in [("gnrm", 1e-3), ("gnrm", 1e-2), ("gnrm", 0.1), ("gnrm", 1e2),
+                      ("gnrm", 1e4), ("auto", 1e-2), ("auto", 1e2)]:
+        problem, run = solve(method, r)
+        assert run.converged, (method, r)
+        if method == "gnrm" and r >= 0.1:  # r_t = 0.1 E/h for all of them
+            assert [s.iterations for s in run.steps] == SERIAL_ITERATIONS
+        assert np.max(np.abs(problem.u.x.array - u_ref)) < 1e-8 * scale, (method, r)
+        assert run.steps[-1].tangential_force == pytest.approx(
+            SERIAL_TANGENTIAL_FORCE, rel=1e-8
+        ), (method, r)
+
+
+def test_uncapped_tangential_r_makes_gnrm_stall_where_sliding_starts():
+    """The reason for r_t = min(r, 0.1 E/h): with r_t = r = 1 E/h the stick/slip guess flips."""
+    _, run = solve("gnrm", 1.0, tangential_r_max=None)
+    assert run.status == "max_iterations"
+    assert run.steps_completed == PRESS_STEPS
+
+
+def test_penalty_slides_at_mu_times_its_normal_force():
+    _, run = solve("penalty", 0.1, cutbacks=4)
+    assert run.converged
+    assert run.cutbacks <= 2  # measured: one halving where sliding starts
+    final = run.steps[-1]
+    assert final.slip_count == final.active_count
+    # penalty: the pressure is r times the penetration (about half of the press here)
+    assert final.contact_force < SERIAL_NORMAL_FORCE
+    assert final.tangential_force == pytest.approx(MU * final.contact_force, rel=1e-8)
+
+
+def test_zero_slip_node_gives_finite_residual_and_jacobian():
+    problem, _ = solve(mu=MU)  # ends sliding: lam_t on the disc
+    strategy = make_strategy("gnrm", problem, SolverSettings())
+    problem.commit()  # u_prev = u, c_prev = c: zero slip at every node
+    problem.lam_t.x.array[:] = 0.0  # y = lam_t + r dg_t = 0 exactly, rho > 0 (closed)
+    problem.lam.x.array[: problem.lam.x.array.size // 2] = 0.0  # some nodes with rho = 0
+    norm = strategy.kernel.assemble_residual()
+    assert np.isfinite(norm)
+    assert strategy.kernel.newton_step()
+    assert np.all(np.isfinite(problem.u.x.array))
+    assert np.all(np.isfinite(problem.lam_t.x.array))
+
+
+def test_scene_rejects_a_bad_friction_coefficient(tmp_path):
+    text = SCENE.read_text()
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text.replace("mu = 0.3", "mu = -0.1"))
+    with pytest.raises(SceneError, match=r"\[contact\] mu = -0.1.*>= 0"):
+        load_scene(bad)
+    bad.write_text(text.replace("mu = 0.3", 'mu = "high"'))
+    with pytest.raises(SceneError, match=r"\[contact\] mu.*number"):
+        load_scene(bad)
+    bad.write_text(text.replace("\nmu = 0.3\n", "\nmu = 0.3\ntangential_r_max = 0.0\n"))
+    with pytest.raises(SceneError, match=r"\[contact\] tangential_r_max = 0.0: must be > 0"):
+        load_scene(bad)
+    bad.write_text(text.replace("[1.0, 0.02, 0.01]]", "[0.9, 0.02, 0.01]]"))
+    with pytest.raises(SceneError, match=r"schedule.*from 0 to 1"):
+        load_scene(bad)
+
+
+def test_obstacle_follows_its_schedule():
+    problem = build_problem(_scene())
+    problem.set_load(0.2)
+    assert np.allclose(problem.obstacle.point.value, [0.0, 0.005])
+    problem.set_load(0.7)
+    assert np.allclose(problem.obstacle.point.value, [0.01, 0.01])
+    assert MPI.COMM_WORLD.size >= 1
+
+
+def test_cattaneo_mindlin_stick_zone_of_a_cylinder_on_a_rigid_plane():
+    """Interim check (beta = 0.09, frictionless pressing): c = a sqrt(1 - Q/(mu P))."""
+    from fenics_contact.verification.cattaneo import CattaneoCylinder, solve_cattaneo
+
+    _, zones, iterations = solve_cattaneo(
+        CattaneoCylinder(shift=0.003), press_steps=2, shear_steps=4
+    )
+    assert max(iterations[2:]) <= 3  # shear steps (pressing: 6 each)
+    ratios = [z.Q / (0.3 * z.P) for z in zones]
+    assert ratios == sorted(ratios) and 0.4 < ratios[-1] < 0.6
+    for zone in zones[1:]:  # measured: within 2.4 %, node spacing 2.5-3.4 % of c
+        assert abs(zone.c_error) < 0.05
+        assert zone.traction_error < 0.12  # measured 0.077 ... 0.090
+        assert zone.slip_nodes > 0 and zone.stick_nodes > 0
+
+
+BLOCK_3D = """
+[scene]
+name = "block-3d-friction"
+dimension = 3
+[mesh]
+generator = "box"
+size = [1.0, 1.0, 0.5]
+cells = [4, 4, 2]
+[material]
+law = "svk"
+E = 1000.0
+nu = 0.0
+[[dirichlet]]
+tag = "zmax"
+value = [0.0, 0.0, 0.0]
+[obstacle]
+type = "plane"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+schedule = [[0.0, 0.0, 0.0, 0.0], [0.4, 0.0, 0.0, 0.01], [1.0, 0.012, 0.016, 0.01]]
+[contact]
+tag = "zmin"
+r = 0.1
+mu = 0.3
+"""
+
+
+@pytest.mark.mpi
+def test_block_slides_diagonally_in_3d(tmp_path):
+    """Two tangential components: the friction force opposes the plane's motion (0.6, 0.8)."""
+    path = tmp_path / "block3d.toml"  # each rank has its own tmp_path
+    path.write_text(BLOCK_3D)
+    problem = build_problem(load_scene(path))
+    strategy = make_strategy("gnrm", problem, SolverSettings(atol=1e-8), predictor="previous")
+    run = solve_load_path(strategy, 10, max_cutbacks=0)
+    assert run.converged
+    assert [s.iterations for s in run.steps] == [2, 2, 2, 2, 2, 5, 5, 2, 2, 2]
+    final = run.steps[-1]
+    assert final.slip_count == final.active_count == 25
+    state = problem.contact_state()
+    area = problem.surface.lumped_area
+    comm = problem.comm
+    friction = comm.allreduce(float(area @ np.linalg.norm(state.tangential_traction, axis=1)))
+    limit = comm.allreduce(float(area @ state.coulomb_limit))
+    assert friction == pytest.approx(limit, rel=1e-10)  # every node on its Coulomb circle
+    force = problem.tangential_force_vector()  # T tau summed: minus the friction on the body
+    assert np.allclose(force / np.linalg.norm(force), [-0.6, -0.8, 0.0], atol=1e-3)
+    # nodal slip directions spread by about 0.4 degrees: the resultant is a bit below mu N
+    assert final.tangential_force / (MU * final.contact_force) == pytest.approx(1.0, abs=1e-5)
+
+
+def test_stability_grid_friction_cases_end_with_a_status():
+    from fenics_contact.studies.stability import friction_grid, run_case
+
+    cases = {c.name: c for c in friction_grid()}
+    assert {"slide-mu0", "slide-mu10", "slide-r1e-8", "slide-r1e12", "slide-reversal"} <= set(
+        cases
+    )
+    uncapped = run_case(cases["slide-rt=r-r1e4"], "gnrm", max_iterations=30)
+    assert uncapped.status == "max_iterations" and uncapped.steps_completed == PRESS_STEPS
+    for method in ("gnrm", "auto"):
+        record = run_case(cases["slide-r1e4"], method)
+        assert record.status == "converged"
+        assert record.steps[-1].tangential_force == pytest.approx(
+            SERIAL_TANGENTIAL_FORCE, rel=1e-8
+        )
+
+
+def test_iterative_linear_solver_takes_both_multipliers_in_one_split():
+    from fenics_contact.solvers.linear import LinearSolverSettings
+
+    problem = build_problem(_scene())
+    strategy = make_strategy(
+        "gnrm", problem, SolverSettings(atol=1e-8, rtol=1e-10), predictor="previous",
+        linear=LinearSolverSettings(kind="iterative"),
+    )
+    run = solve_load_path(strategy, 20, max_cutbacks=0)
+    assert [s.iterations for s in run.steps] == SERIAL_ITERATIONS
+    assert run.steps[-1].tangential_force == pytest.approx(SERIAL_TANGENTIAL_FORCE, rel=1e-8)
