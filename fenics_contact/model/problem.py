@@ -215,6 +215,9 @@ class ProblemBase:
         """Apply the load factor t."""
         raise NotImplementedError
 
+    def commit(self) -> None:
+        """Accept the current state as converged (history-dependent terms; none here)."""
+
     def set_r(self, r: float, *, relative: bool) -> None:
         """Set the penalty/augmentation parameter, relative to E/h or absolute."""
         check_r(r)
@@ -394,9 +397,6 @@ class ContactProblem(ProblemBase):
             return t * self._motion
         times, offsets = self._schedule
         return np.array([np.interp(t, times, offsets[:, i]) for i in range(offsets.shape[1])])
-
-    def commit(self) -> None:
-        """Accept the current state as converged (history-dependent terms; none here)."""
 
     def _external_work(self, tractions: Sequence[SurfaceTraction]) -> ufl.Form | None:
         if not tractions:
