@@ -48,7 +48,14 @@ def _owned(space: fem.FunctionSpace) -> int:
 
 
 class CondensedKernel(NewtonKernel):
-    """Newton on (u[, lam]) of a system extended by selected target displacements."""
+    """Newton on (u[, lam]) of a system extended by selected target displacements.
+
+    The Newton step is :meth:`NewtonKernel.newton_step`; the hooks
+    :meth:`_assemble_b` and :meth:`_assemble_A` condense F and J with P.
+    """
+
+    #: A may be a new matrix after a search changed P.
+    _operator_each_step = True
 
     def __init__(
         self, system: VariationalSystem, linear: LinearSolverSettings | None = None
@@ -173,8 +180,8 @@ class CondensedKernel(NewtonKernel):
         z = self.z.getArray()
         z[self._bc_local] = u[self._bc_local] - self._g[self._bc_local]
 
-    def assemble_residual(self) -> float:
-        """Search, assemble R_ext, condense, set Dirichlet rows; return the norm."""
+    def _assemble_b(self) -> float:
+        """Search, assemble R_ext, condense b = P^T R_ext, set Dirichlet rows; return the norm."""
         self._refresh()
         with stopwatch(self.timings, "residual_s"):
             self._pull()
@@ -188,35 +195,13 @@ class CondensedKernel(NewtonKernel):
             self._boundary_values()
             arr = self.b.getArray()
             arr[self._bc_local] = self.z.getArray(readonly=True)[self._bc_local]
-            self.residual_norm = float(self.b.norm())
-        self.timings.residuals += 1
-        return self.residual_norm
+            return float(self.b.norm())
 
-    def newton_step(self, damping: float = 1.0) -> bool:
-        """Condensed Jacobian, Dirichlet elimination with lifting, solve, update."""
-        t = self.timings
+    def _assemble_A(self) -> None:
+        """Condensed Jacobian A = P^T J_ext P, Dirichlet elimination lifting b."""
         self._assemble_condensed_jacobian()
-        with stopwatch(t, "transfer_s"):
+        with stopwatch(self.timings, "transfer_s"):
             self.A.zeroRowsColumns(self._bc_rows, 1.0, self.z, self.b)
-        try:
-            with stopwatch(t, "setup_s"):
-                self.ksp.setOperators(self.A)
-                self.ksp.setUp()
-                self.ksp.getPC().setUp()
-            with stopwatch(t, "solve_s"):
-                self.ksp.solve(self.b, self.dx)
-        except PETSc.Error:
-            return False
-        self.linear_solves += 1
-        t.linear_solves += 1
-        t.krylov_iterations += self.ksp.getIterationNumber() if self.linear.kind != "direct" else 0
-        if self.ksp.getConvergedReason() < 0:
-            return False
-        if not np.all(np.isfinite(self.dx.getArray(readonly=True))):
-            return False
-        self.x.axpy(-damping, self.dx)
-        self._push()
-        return True
 
     def destroy(self) -> None:
         """Free the PETSc objects."""
