@@ -31,7 +31,7 @@ from petsc4py import PETSc
 from fenics_contact.model.problem import VariationalSystem
 from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.newton import NewtonKernel
-from fenics_contact.solvers.timing import KernelTimings, stopwatch
+from fenics_contact.solvers.timing import stopwatch
 
 _prefix_counter = itertools.count()
 
@@ -60,12 +60,9 @@ class CondensedKernel(NewtonKernel):
     def __init__(
         self, system: VariationalSystem, linear: LinearSolverSettings | None = None
     ) -> None:
-        self.timings = KernelTimings()
-        self.system = system
-        self.unknowns = system.unknowns
+        self._start(system)
         self.extras = system.extras
         self.transfer = system.transfer
-        self.bcs = system.bcs
         ext = [*self.unknowns, *self.extras]
         comm = self.unknowns[0].function_space.mesh.comm
         self._comm = comm
@@ -75,14 +72,10 @@ class CondensedKernel(NewtonKernel):
             blocks = [[_nonempty(f) for f in row] for row in blocks]
             self.J_ext = fem.form(blocks, entity_maps=system.entity_maps)
             self.A_ext = fem_petsc.create_matrix(self.J_ext, kind="mpi")
-            self.spaces = [u.function_space for u in self.unknowns]
             self.ext_spaces = [f.function_space for f in ext]
             self.b_ext = fem_petsc.create_vector(self.ext_spaces, kind="mpi")
-            self.b = fem_petsc.create_vector(self.spaces, kind="mpi")
-            self.x = fem_petsc.create_vector(self.spaces, kind="mpi")
-            self.dx = fem_petsc.create_vector(self.spaces, kind="mpi")
+            self._work_vectors()
             self.z = fem_petsc.create_vector(self.spaces, kind="mpi")
-        self._blocks = self.b.getAttr("_blocks")
         self._prefix = f"fc_{system.name}2_{next(_prefix_counter)}_"
         # Layouts: each rank owns its rows block after block (see linear.block_index_sets).
         n_red = sum(_owned(V) for V in self.spaces)
@@ -106,14 +99,10 @@ class CondensedKernel(NewtonKernel):
         self.P: PETSc.Mat | None = None
         self.A: PETSc.Mat | None = None
         self._P_version = None
-        self.ksp = None
-        self._keep: tuple = ()
         self.linear = linear or LinearSolverSettings()
         self._refresh()
         self._assemble_condensed_jacobian()
         self.set_linear_solver(self.linear)
-        self.linear_solves = 0
-        self.residual_norm = np.inf
         self.rebuilds = 0
 
     # -- selection -------------------------------------------------------------

@@ -45,27 +45,35 @@ class NewtonKernel:
     def __init__(
         self, system: VariationalSystem, linear: LinearSolverSettings | None = None
     ) -> None:
-        self.timings = KernelTimings()
-        self.system = system
-        self.unknowns = system.unknowns
-        self.bcs = system.bcs
+        self._start(system)
         with stopwatch(self.timings, "compile_s"):
             self.F = fem.form(system.residuals, entity_maps=system.entity_maps)
             jacobian = fem.forms.derivative_block(system.residuals, system.unknowns)
             self.J = fem.form(jacobian, entity_maps=system.entity_maps)
             self.A = fem_petsc.create_matrix(self.J, kind="mpi")
-            self.spaces = [u.function_space for u in self.unknowns]
-            self.b = fem_petsc.create_vector(self.spaces, kind="mpi")
-            self.x = fem_petsc.create_vector(self.spaces, kind="mpi")
-            self.dx = fem_petsc.create_vector(self.spaces, kind="mpi")
-        self._blocks = self.b.getAttr("_blocks")
+            self._work_vectors()
         self._prefix = f"fc_{system.name}_{next(_prefix_counter)}_"
         self.A.setOptionsPrefix(f"{self._prefix}A_")
+        self.set_linear_solver(linear or LinearSolverSettings())
+
+    def _start(self, system: VariationalSystem) -> None:
+        """The state every kernel starts from: the system, empty timings and counters."""
+        self.timings = KernelTimings()
+        self.system = system
+        self.unknowns = system.unknowns
+        self.bcs = system.bcs
         self.ksp: PETSc.KSP | None = None
         self._keep: tuple = ()
-        self.set_linear_solver(linear or LinearSolverSettings())
         self.linear_solves = 0
         self.residual_norm = np.inf
+
+    def _work_vectors(self) -> None:
+        """Vectors b (residual), x (unknowns) and dx (Newton update) on the unknowns' spaces."""
+        self.spaces = [u.function_space for u in self.unknowns]
+        self.b = fem_petsc.create_vector(self.spaces, kind="mpi")
+        self.x = fem_petsc.create_vector(self.spaces, kind="mpi")
+        self.dx = fem_petsc.create_vector(self.spaces, kind="mpi")
+        self._blocks = self.b.getAttr("_blocks")
 
     # -- linear solver -------------------------------------------------------
     def set_linear_solver(self, settings: LinearSolverSettings) -> None:
