@@ -21,13 +21,11 @@ from mpi4py import MPI
 
 import fenics_contact  # noqa: F401  (before dolfinx)
 from fenics_contact.model.contact import ContactSettings
-from fenics_contact.model.materials import material
-from fenics_contact.model.pairs import Body, TwoBodyProblem
-from fenics_contact.model.problem import PrescribedDisplacement
 from fenics_contact.scene import two_body_meshing as tbm
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.verification.hertz_problem import HertzCylinder
+from fenics_contact.verification.two_body_examples import hemispheres_fixed, linear_pair
 
 STEPS = 10
 
@@ -53,16 +51,8 @@ def _solve(problem) -> dict:
 
 def two_bodies(h: float) -> dict:
     md = tbm.two_half_disks(MPI.COMM_WORLD, h_contact=h, h_far=0.1)
-    ft = md.facet_tags
-    law = material("linear", 200.0, 0.3)
-    problem = TwoBodyProblem(
-        md.mesh, md.cell_tags,
-        [Body("upper", tbm.STRIKER_TAG, law), Body("lower", tbm.TARGET_TAG, law)],
-        ft.find(tbm.STRIKER_FACE_TAG), ft.find(tbm.TARGET_FACE_TAG), ContactSettings(r=1.0),
-        prescribed=[PrescribedDisplacement(ft.find(tbm.LOAD_TAG), (0.0, -0.02)),
-                    PrescribedDisplacement(ft.find(tbm.SUPPORT_TAG), (0.0, 0.0))],
-    )
-    return _solve(problem)
+    fixed = {tbm.LOAD_TAG: (0.0, -0.02), tbm.SUPPORT_TAG: (0.0, 0.0)}
+    return _solve(linear_pair(md, ContactSettings(r=1.0), fixed))
 
 
 def one_body(h: float) -> dict:
@@ -73,20 +63,7 @@ def one_body(h: float) -> dict:
 
 def two_bodies_3d(h: float) -> dict:
     md = tbm.two_hemispheres(MPI.COMM_WORLD, h_contact=h, h_far=2.5 * h)
-    ft = md.facet_tags
-    law = material("linear", 200.0, 0.3)
-    problem = TwoBodyProblem(
-        md.mesh, md.cell_tags,
-        [Body("upper", tbm.STRIKER_TAG, law), Body("lower", tbm.TARGET_TAG, law)],
-        ft.find(tbm.STRIKER_FACE_TAG), ft.find(tbm.TARGET_FACE_TAG), ContactSettings(r=1.0),
-        prescribed=[
-            PrescribedDisplacement(ft.find(tbm.LOAD_TAG), (None, None, -0.02)),
-            PrescribedDisplacement(ft.find(tbm.SUPPORT_TAG), (None, None, 0.0)),
-            PrescribedDisplacement(ft.find(tbm.SYMMETRY_TAG), (0.0, None, None)),
-            PrescribedDisplacement(ft.find(tbm.SYMMETRY_Y_TAG), (None, 0.0, None)),
-        ],
-    )
-    return _solve(problem)
+    return _solve(linear_pair(md, ContactSettings(r=1.0), hemispheres_fixed(0.02)))
 
 
 def one_body_3d(h: float) -> dict:

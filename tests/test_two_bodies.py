@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from dolfinx.mesh import MeshTags
 
 from mpi4py import MPI
 
@@ -16,6 +17,12 @@ from fenics_contact.scene import two_body_meshing as tbm
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.verification.hertz import fit_contact_profile, half_width, peak_pressure
+from fenics_contact.verification.two_body_examples import (
+    BlockOnBlock,
+    TwoCylinders,
+    hemispheres_fixed,
+    linear_pair,
+)
 
 
 # -- search --------------------------------------------------------------------------
@@ -66,20 +73,9 @@ def test_search_matches_brute_force() -> None:
 
 
 # -- problems --------------------------------------------------------------------------
-def _blocks(n_upper: int, n_lower: int, r: float = 1.0) -> TwoBodyProblem:
-    md = tbm.block_on_block(MPI.COMM_WORLD, n_upper=n_upper, n_lower=n_lower)
-    ft = md.facet_tags
-    law = material("linear", 200.0, 0.3)
-    return TwoBodyProblem(
-        md.mesh, md.cell_tags,
-        [Body("upper", tbm.STRIKER_TAG, law), Body("lower", tbm.TARGET_TAG, law)],
-        ft.find(tbm.STRIKER_FACE_TAG), ft.find(tbm.TARGET_FACE_TAG), ContactSettings(r=r),
-        prescribed=[
-            PrescribedDisplacement(ft.find(tbm.LOAD_TAG), (None, -0.01)),
-            PrescribedDisplacement(ft.find(tbm.SUPPORT_TAG), (None, 0.0)),
-            PrescribedDisplacement(ft.find(tbm.SYMMETRY_TAG), (0.0, None)),
-        ],
-    ), ft
+def _blocks(n_upper: int, n_lower: int, r: float = 1.0) -> tuple[TwoBodyProblem, MeshTags]:
+    md = BlockOnBlock(n_upper, n_lower).mesh()
+    return linear_pair(md, ContactSettings(r=r), BlockOnBlock.FIXED), md.facet_tags
 
 
 def _solve(problem, method: str, steps: int) -> list:
@@ -147,18 +143,7 @@ def test_strategies_on_two_bodies(method: str, r: float) -> None:
 
 
 def _cylinders(h: float, r: float) -> TwoBodyProblem:
-    md = tbm.two_half_disks(MPI.COMM_WORLD, h_contact=h, h_far=0.2)
-    ft = md.facet_tags
-    law = material("linear", 200.0, 0.3)
-    return TwoBodyProblem(
-        md.mesh, md.cell_tags,
-        [Body("upper", tbm.STRIKER_TAG, law), Body("lower", tbm.TARGET_TAG, law)],
-        ft.find(tbm.STRIKER_FACE_TAG), ft.find(tbm.TARGET_FACE_TAG), ContactSettings(r=r),
-        prescribed=[
-            PrescribedDisplacement(ft.find(tbm.LOAD_TAG), (0.0, -0.02)),
-            PrescribedDisplacement(ft.find(tbm.SUPPORT_TAG), (0.0, 0.0)),
-        ],
-    )
+    return TwoCylinders(h_contact=h, push=0.02).build(ContactSettings(r=r))
 
 
 @pytest.fixture(scope="module")
@@ -294,19 +279,7 @@ def test_two_hemispheres_hertz_coarse() -> None:
     from fenics_contact.verification.hertz3d import hertz_point_contact
 
     md = tbm.two_hemispheres(MPI.COMM_WORLD, h_contact=0.05)
-    ft = md.facet_tags
-    law = material("linear", 200.0, 0.3)
-    problem = TwoBodyProblem(
-        md.mesh, md.cell_tags,
-        [Body("upper", tbm.STRIKER_TAG, law), Body("lower", tbm.TARGET_TAG, law)],
-        ft.find(tbm.STRIKER_FACE_TAG), ft.find(tbm.TARGET_FACE_TAG), ContactSettings(r=1.0),
-        prescribed=[
-            PrescribedDisplacement(ft.find(tbm.LOAD_TAG), (None, None, -0.02)),
-            PrescribedDisplacement(ft.find(tbm.SUPPORT_TAG), (None, None, 0.0)),
-            PrescribedDisplacement(ft.find(tbm.SYMMETRY_TAG), (0.0, None, None)),
-            PrescribedDisplacement(ft.find(tbm.SYMMETRY_Y_TAG), (None, 0.0, None)),
-        ],
-    )
+    problem = linear_pair(md, ContactSettings(r=1.0), hemispheres_fixed(0.02))
     its = _solve(problem, "gnrm", 2)
     assert all(i <= 6 for i in its)
     state = problem.contact_state()

@@ -175,6 +175,37 @@ class ContactState:
     max_penetration: float
     contact_force: float
 
+    @classmethod
+    def gathered(
+        cls,
+        comm: MPI.Comm,
+        gap: np.ndarray,
+        pressure: np.ndarray,
+        multiplier: np.ndarray,
+        local_force: float,
+    ) -> ContactState:
+        """The state from this rank's nodal values, with the summaries reduced over ``comm``.
+
+        Args:
+            comm: communicator of the problem.
+            gap: owned nodal gaps (length).
+            pressure: owned nodal min(lam + r g, 0) (<= 0); active where < 0.
+            multiplier: owned nodal multipliers.
+            local_force: this rank's share of the contact force (force).
+        """
+        active = pressure < 0.0
+        return cls(
+            gap=gap,
+            pressure=pressure,
+            multiplier=multiplier,
+            active=active,
+            active_count=comm.allreduce(int(active.sum()), op=MPI.SUM),
+            max_penetration=comm.allreduce(
+                float(np.max(-np.minimum(gap, 0.0), initial=0.0)) + 0.0, op=MPI.MAX
+            ),
+            contact_force=comm.allreduce(local_force, op=MPI.SUM),
+        )
+
 
 @dataclass(frozen=True)
 class DetFMinimum:
@@ -214,6 +245,9 @@ class ProblemBase:
     def set_load(self, t: float) -> None:
         """Apply the load factor t."""
         raise NotImplementedError
+
+    def commit(self) -> None:
+        """Accept the current state as converged (history-dependent terms; none here)."""
 
     def set_r(self, r: float, *, relative: bool) -> None:
         """Set the penalty/augmentation parameter, relative to E/h or absolute."""
@@ -395,9 +429,6 @@ class ContactProblem(ProblemBase):
         times, offsets = self._schedule
         return np.array([np.interp(t, times, offsets[:, i]) for i in range(offsets.shape[1])])
 
-    def commit(self) -> None:
-        """Accept the current state as converged (history-dependent terms; none here)."""
-
     def _external_work(self, tractions: Sequence[SurfaceTraction]) -> ufl.Form | None:
         if not tractions:
             return None
@@ -461,23 +492,10 @@ class ContactProblem(ProblemBase):
     def contact_state(self) -> ContactState:
         """Nodal gaps, pressures, the active set and global summaries."""
         gap = self.surface.nodal(self._gap_form)
-        pressure = self.surface.nodal(self._pressure_form)
-        n_owned = gap.size
-        multiplier = self.lam.x.array[:n_owned].copy()
-        active = pressure < 0.0
-        comm = self.comm
-        return ContactState(
-            gap=gap,
-            pressure=pressure,
-            multiplier=multiplier,
-            active=active,
-            active_count=comm.allreduce(int(active.sum()), op=MPI.SUM),
-            max_penetration=comm.allreduce(
-                float(np.max(-np.minimum(gap, 0.0), initial=0.0)) + 0.0, op=MPI.MAX
-            ),
-            contact_force=comm.allreduce(
-                fem.assemble_scalar(self._contact_force_form()), op=MPI.SUM
-            ),
+        return ContactState.gathered(
+            self.comm, gap, self.surface.nodal(self._pressure_form),
+            self.lam.x.array[: gap.size].copy(),
+            fem.assemble_scalar(self._contact_force_form()),
         )
 
     def _contact_force_form(self) -> fem.Form:

@@ -7,9 +7,9 @@ The gmsh model is created on one MPI rank only and distributed by
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 from dolfinx.io.gmsh import MeshData, model_to_mesh
 
@@ -68,48 +68,23 @@ def hertz_half_disk(
         The dolfinx ``MeshData``: use its ``mesh``, ``cell_tags`` and
         ``facet_tags``.
     """
-    fine, coarse = _grading(
+    grading = _Grading.checked(
         "disk", radius, h_contact, h_far,
         0.1 * radius if fine_radius is None else fine_radius,
         0.5 * radius if coarse_radius is None else coarse_radius,
     )
-
-    return mesh_on_rank(
-        comm, rank, 2,
-        lambda gmsh: _build_half_disk(gmsh, radius, h_contact, h_far, fine, coarse, verbosity),
-    )
+    return mesh_on_rank(comm, rank, 2, lambda gmsh: _build_half_disk(gmsh, grading, verbosity))
 
 
-def _build_half_disk(
-    gmsh,  # the gmsh module (imported lazily)
-    radius: float,
-    h_contact: float,
-    h_far: float,
-    fine: float,
-    coarse: float,
-    verbosity: int,
-) -> None:
+def _build_half_disk(gmsh: Any, g: _Grading, verbosity: int) -> None:
     """Create and mesh the half-disk model in the current gmsh session."""
-    gmsh.option.setNumber("General.Verbosity", verbosity)
-    gmsh.model.add("hertz_half_disk")
-    geo = gmsh.model.geo
-    R = radius
-    centre = geo.addPoint(0.0, R, 0.0, h_far)
-    left = geo.addPoint(-R, R, 0.0, h_far)
-    bottom = geo.addPoint(0.0, 0.0, 0.0, h_contact)
-    right = geo.addPoint(R, R, 0.0, h_far)
-    arc_left = geo.addCircleArc(left, centre, bottom)
-    arc_right = geo.addCircleArc(bottom, centre, right)
-    top = geo.addLine(right, left)
-    loop = geo.addCurveLoop([arc_left, arc_right, top])
-    surface = geo.addPlaneSurface([loop])
-    geo.synchronize()
-
-    gmsh.model.addPhysicalGroup(2, [surface], BODY_TAG, name="body")
-    gmsh.model.addPhysicalGroup(1, [top], TOP_TAG, name="top")
-    gmsh.model.addPhysicalGroup(1, [arc_left, arc_right], CONTACT_TAG, name="contact")
-
-    _graded_toward(gmsh, [bottom], h_contact, h_far, fine, coarse)
+    new_model(gmsh, "hertz_half_disk", verbosity)
+    bottom, arcs, top, surface = half_disk(gmsh.model.geo, g.radius, h_rim=g.h_far,
+                                           h_tip=g.h_contact)
+    gmsh.model.geo.synchronize()
+    add_groups(gmsh, 2, {BODY_TAG: ("body", [surface])})
+    add_groups(gmsh, 1, {TOP_TAG: ("top", [top]), CONTACT_TAG: ("contact", arcs)})
+    g.toward(gmsh, [bottom])
     gmsh.option.setNumber("Mesh.Algorithm", 6)  # Frontal-Delaunay
     gmsh.model.mesh.generate(2)
 
@@ -158,95 +133,174 @@ def hertz_sphere_octant(
     Returns:
         The dolfinx ``MeshData`` (``mesh``, ``cell_tags``, ``facet_tags``).
     """
-    fine, coarse = _grading(
+    grading = _Grading.checked(
         "sphere", radius, h_contact, h_far,
         0.15 * radius if fine_radius is None else fine_radius,
         0.6 * radius if coarse_radius is None else coarse_radius,
     )
-
-    return mesh_on_rank(
-        comm, rank, 3,
-        lambda gmsh: _build_sphere_octant(gmsh, radius, h_contact, h_far, fine, coarse, verbosity),
-    )
+    return mesh_on_rank(comm, rank, 3, lambda gmsh: _build_sphere_octant(gmsh, grading, verbosity))
 
 
-def _build_sphere_octant(
-    gmsh,  # the gmsh module (imported lazily)
-    radius: float,
-    h_contact: float,
-    h_far: float,
-    fine: float,
-    coarse: float,
-    verbosity: int,
-) -> None:
+def _build_sphere_octant(gmsh: Any, g: _Grading, verbosity: int) -> None:
     """Create and mesh the sphere-octant model in the current gmsh session."""
-    gmsh.option.setNumber("General.Verbosity", verbosity)
-    gmsh.model.add("hertz_sphere_octant")
-    occ = gmsh.model.occ
-    R = radius
-    ball = occ.addSphere(0.0, 0.0, R, R)
-    box = occ.addBox(0.0, 0.0, 0.0, R, R, R)
-    (body, *_), _ = occ.intersect([(3, ball)], [(3, box)])
-    occ.synchronize()
-    groups: dict[int, list[int]] = {TOP_TAG: [], CONTACT_TAG: [], SYMMETRY_X_TAG: [],
-                                    SYMMETRY_Y_TAG: []}
+    new_model(gmsh, "hertz_sphere_octant", verbosity)
+    R = g.radius
+    (body,) = ball_quarters(gmsh, R, [R])
+    faces = quarter_faces(gmsh, body, R)
+    add_groups(gmsh, 3, {BODY_TAG: ("body", [body[1]])})
+    add_groups(gmsh, 2, {
+        TOP_TAG: ("top", faces["flat"]), CONTACT_TAG: ("contact", faces["curved"]),
+        SYMMETRY_X_TAG: ("symmetry_x", faces["x"]), SYMMETRY_Y_TAG: ("symmetry_y", faces["y"]),
+    })
     tol = 1e-6 * R
-    for dim, tag in gmsh.model.getBoundary([body], oriented=False):
-        xmin, ymin, zmin, xmax, ymax, zmax = gmsh.model.getBoundingBox(dim, tag)
-        if zmax - zmin < tol and abs(zmin - R) < tol:
-            groups[TOP_TAG].append(tag)
-        elif xmax - xmin < tol and abs(xmin) < tol:
-            groups[SYMMETRY_X_TAG].append(tag)
-        elif ymax - ymin < tol and abs(ymin) < tol:
-            groups[SYMMETRY_Y_TAG].append(tag)
-        else:
-            groups[CONTACT_TAG].append(tag)
-    gmsh.model.addPhysicalGroup(3, [body[1]], BODY_TAG, name="body")
-    names = {TOP_TAG: "top", CONTACT_TAG: "contact", SYMMETRY_X_TAG: "symmetry_x",
-             SYMMETRY_Y_TAG: "symmetry_y"}
-    for tag, surfaces in groups.items():
-        gmsh.model.addPhysicalGroup(2, surfaces, tag, name=names[tag])
-
     lowest = [tag for dim, tag in gmsh.model.getEntities(0)
               if max(abs(c) for c in gmsh.model.getValue(0, tag, [])) < tol]
-    _graded_toward(gmsh, lowest, h_contact, h_far, fine, coarse)
+    g.toward(gmsh, lowest)
     gmsh.model.mesh.generate(3)
 
 
-def _grading(
-    shape: str, radius: float, h_contact: float, h_far: float, fine: float, coarse: float
-) -> tuple[float, float]:
-    """Check the sizes of a graded mesh; return (fine, coarse) radii."""
-    if not radius > 0:
-        raise ValueError(f"The {shape} radius must be > 0, got {radius}.")
-    if not 0 < h_contact <= h_far:
-        raise ValueError(
-            f"Element sizes need 0 < h_contact <= h_far, got h_contact={h_contact}, h_far={h_far}."
-        )
-    if not 0 <= fine < coarse:
-        raise ValueError(
-            f"Grading radii need 0 <= fine_radius < coarse_radius, got {fine} and {coarse}."
-        )
-    return fine, coarse
+class _Grading(NamedTuple):
+    """Body radius and element sizes of a mesh graded toward its contact point (lengths)."""
+
+    radius: float
+    h_contact: float
+    h_far: float
+    fine: float
+    coarse: float
+
+    @classmethod
+    def checked(
+        cls, shape: str, radius: float, h_contact: float, h_far: float, fine: float,
+        coarse: float,
+    ) -> _Grading:
+        """The grading, after checking the sizes (``ValueError`` naming the bad ones)."""
+        if not radius > 0:
+            raise ValueError(f"The {shape} radius must be > 0, got {radius}.")
+        if not 0 < h_contact <= h_far:
+            raise ValueError(
+                f"Element sizes need 0 < h_contact <= h_far, got h_contact={h_contact}, "
+                f"h_far={h_far}."
+            )
+        if not 0 <= fine < coarse:
+            raise ValueError(
+                f"Grading radii need 0 <= fine_radius < coarse_radius, got {fine} and {coarse}."
+            )
+        return cls(radius, h_contact, h_far, fine, coarse)
+
+    def toward(self, gmsh: Any, points: list[int]) -> None:
+        """Size field: h_contact within ``fine`` of the points, h_far beyond ``coarse``.
+
+        The field alone sets the size: no point sizes, no curvature sizes.
+        """
+        distance = gmsh.model.mesh.field.add("Distance")
+        gmsh.model.mesh.field.setNumbers(distance, "PointsList", points)
+        size_field_only(gmsh, threshold_field(
+            gmsh, distance, self.h_contact, self.h_far, self.fine, self.coarse
+        ))
 
 
-def _graded_toward(
-    gmsh: Any, points: list[int], h_contact: float, h_far: float, fine: float, coarse: float
-) -> None:
-    """Size field: h_contact within ``fine`` of the points, h_far beyond ``coarse``.
+# -- shared gmsh building blocks (used by two_body_meshing too) -------------------
 
-    The field alone sets the size: no point sizes, no curvature sizes.
+
+def new_model(gmsh: Any, name: str, verbosity: int = 0, *, separate: bool = False) -> None:
+    """Add a model ``name`` to the gmsh session at ``verbosity``.
+
+    ``separate`` keeps coincident points of distinct bodies apart
+    (``Geometry.AutoCoherence`` 0): the bodies of a contact pair share no nodes.
     """
+    gmsh.option.setNumber("General.Verbosity", verbosity)
+    if separate:
+        gmsh.option.setNumber("Geometry.AutoCoherence", 0)
+    gmsh.model.add(name)
+
+
+def add_groups(gmsh: Any, dim: int, groups: dict[int, tuple[str, Sequence[int]]]) -> None:
+    """Add one physical group of dimension ``dim`` per entry ``{tag: (name, entities)}``."""
+    for tag, (name, entities) in groups.items():
+        gmsh.model.addPhysicalGroup(dim, list(entities), tag, name=name)
+
+
+def half_disk(
+    geo: Any, radius: float, side: float = 1.0, h_rim: float = 0.0, h_tip: float = 0.0
+) -> tuple[int, list[int], int, int]:
+    """A half-disk of the built-in kernel ``geo`` touching the origin with its arc.
+
+    The centre is (0, side R) and the flat face lies on y = side R (side = 1:
+    above the x axis, -1: below). Points get the mesh sizes ``h_rim``
+    (centre and rim ends) and ``h_tip`` (the origin); 0 leaves them unset.
+
+    Returns:
+        (tip point, [two arcs], flat line, plane surface) tags.
+    """
+    y = side * radius
+    centre = geo.addPoint(0.0, y, 0.0, h_rim)
+    left = geo.addPoint(-radius, y, 0.0, h_rim)
+    tip = geo.addPoint(0.0, 0.0, 0.0, h_tip)
+    right = geo.addPoint(radius, y, 0.0, h_rim)
+    arcs = [geo.addCircleArc(left, centre, tip), geo.addCircleArc(tip, centre, right)]
+    flat = geo.addLine(right, left)
+    surface = geo.addPlaneSurface([geo.addCurveLoop([*arcs, flat])])
+    return tip, arcs, flat, surface
+
+
+def ball_quarters(gmsh: Any, radius: float, centres_z: Sequence[float]) -> list[tuple[int, int]]:
+    """Quarters x, y >= 0 of the hemispheres of radius R facing the plane z = 0 (OCC).
+
+    For each centre (0, 0, c) with c = +-R, the part of the ball between z = 0
+    and z = c. The model is synchronized; returns the (3, tag) of each volume.
+    """
+    occ = gmsh.model.occ
+    bodies = []
+    for c in centres_z:
+        ball = occ.addSphere(0.0, 0.0, c, radius)
+        box = occ.addBox(0.0, 0.0, min(c, 0.0), radius, radius, radius)
+        (body, *_), _ = occ.intersect([(3, ball)], [(3, box)])
+        bodies.append(body)
+    occ.synchronize()
+    return bodies
+
+
+def quarter_faces(gmsh: Any, body: tuple[int, int], radius: float) -> dict[str, list[int]]:
+    """Sort the faces of a ball quarter (:func:`ball_quarters`) by role.
+
+    Returns the surface tags under "flat" (the face |z| = R), "x" (x = 0),
+    "y" (y = 0) and "curved" (the spherical face).
+    """
+    tol = 1e-6 * radius
+    faces: dict[str, list[int]] = {"flat": [], "x": [], "y": [], "curved": []}
+    for dim, tag in gmsh.model.getBoundary([body], oriented=False):
+        xmin, ymin, zmin, xmax, ymax, zmax = gmsh.model.getBoundingBox(dim, tag)
+        if zmax - zmin < tol and abs(abs(zmin) - radius) < tol:
+            faces["flat"].append(tag)
+        elif xmax - xmin < tol and abs(xmin) < tol:
+            faces["x"].append(tag)
+        elif ymax - ymin < tol and abs(ymin) < tol:
+            faces["y"].append(tag)
+        else:
+            faces["curved"].append(tag)
+    return faces
+
+
+def threshold_field(
+    gmsh: Any, in_field: int, size_min: float, size_max: float, dist_min: float, dist_max: float
+) -> int:
+    """A Threshold field on ``in_field``: size_min below dist_min, size_max beyond dist_max."""
     field = gmsh.model.mesh.field
-    distance = field.add("Distance")
-    field.setNumbers(distance, "PointsList", points)
     threshold = field.add("Threshold")
-    field.setNumber(threshold, "InField", distance)
-    field.setNumber(threshold, "SizeMin", h_contact)
-    field.setNumber(threshold, "SizeMax", h_far)
-    field.setNumber(threshold, "DistMin", fine)
-    field.setNumber(threshold, "DistMax", coarse)
-    field.setAsBackgroundMesh(threshold)
+    field.setNumber(threshold, "InField", in_field)
+    field.setNumber(threshold, "SizeMin", size_min)
+    field.setNumber(threshold, "SizeMax", size_max)
+    field.setNumber(threshold, "DistMin", dist_min)
+    field.setNumber(threshold, "DistMax", dist_max)
+    return threshold
+
+
+def size_field_only(gmsh: Any, field: int) -> None:
+    """Make ``field`` the background mesh and the only source of element sizes.
+
+    No point sizes, no sizes from the boundary or from curvature.
+    """
+    gmsh.model.mesh.field.setAsBackgroundMesh(field)
     gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
     gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
     gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)

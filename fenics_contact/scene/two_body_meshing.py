@@ -9,11 +9,23 @@ the same geometries for the gmsh command line.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import Any
+
 from dolfinx.io.gmsh import MeshData
 
 from mpi4py import MPI
 
-from fenics_contact.scene.meshing import mesh_on_rank
+from fenics_contact.scene.meshing import (
+    add_groups,
+    ball_quarters,
+    half_disk,
+    mesh_on_rank,
+    new_model,
+    quarter_faces,
+    size_field_only,
+    threshold_field,
+)
 
 #: Cell tags.
 STRIKER_TAG, TARGET_TAG = 1, 2
@@ -26,6 +38,29 @@ def _check(**sizes: float) -> None:
     for name, value in sizes.items():
         if not value > 0:
             raise ValueError(f"{name} must be > 0, got {name} = {value}.")
+
+
+def _add_pair_groups(
+    gmsh: Any,
+    dim: int,
+    bodies: tuple[int, int],
+    faces: dict[int, Sequence[int]],
+    face_names: tuple[str, str],
+) -> None:
+    """Physical groups shared by every pair: the two bodies and four facet groups.
+
+    Args:
+        gmsh: the gmsh module.
+        dim: dimension of the bodies (their facets have ``dim - 1``).
+        bodies: (striker, target) entity tags.
+        faces: entities under LOAD_TAG, STRIKER_FACE_TAG, TARGET_FACE_TAG, SUPPORT_TAG.
+        face_names: names of the striker and target contact faces.
+    """
+    add_groups(gmsh, dim, {STRIKER_TAG: ("striker", [bodies[0]]),
+                           TARGET_TAG: ("target", [bodies[1]])})
+    names = {LOAD_TAG: "top", STRIKER_FACE_TAG: face_names[0],
+             TARGET_FACE_TAG: face_names[1], SUPPORT_TAG: "bottom"}
+    add_groups(gmsh, dim - 1, {tag: (names[tag], faces[tag]) for tag in names})
 
 
 def two_half_disks(
@@ -48,41 +83,22 @@ def two_half_disks(
     _check(radius=radius, h_contact=h_contact, h_far=h_far, target_ratio=target_ratio)
 
     def build(gmsh) -> None:
-        gmsh.option.setNumber("General.Verbosity", 0)
-        gmsh.option.setNumber("Geometry.AutoCoherence", 0)  # keep the bodies apart
-        gmsh.model.add("two_half_disks")
-        geo = gmsh.model.geo
-        R = radius
-        tags = {}
-        for name, sign, h in (("upper", 1.0, h_contact), ("lower", -1.0, h_contact * target_ratio)):
-            c = geo.addPoint(0.0, sign * R, 0.0)
-            left = geo.addPoint(-R, sign * R, 0.0)
-            tip = geo.addPoint(0.0, 0.0, 0.0)
-            right = geo.addPoint(R, sign * R, 0.0)
-            a1 = geo.addCircleArc(left, c, tip)
-            a2 = geo.addCircleArc(tip, c, right)
-            flat = geo.addLine(right, left)
-            surf = geo.addPlaneSurface([geo.addCurveLoop([a1, a2, flat])])
-            tags[name] = (tip, [a1, a2], flat, surf, h)
-        geo.synchronize()
-        up, lo = tags["upper"], tags["lower"]
-        gmsh.model.addPhysicalGroup(2, [up[3]], STRIKER_TAG, name="striker")
-        gmsh.model.addPhysicalGroup(2, [lo[3]], TARGET_TAG, name="target")
-        gmsh.model.addPhysicalGroup(1, [up[2]], LOAD_TAG, name="top")
-        gmsh.model.addPhysicalGroup(1, up[1], STRIKER_FACE_TAG, name="striker_arc")
-        gmsh.model.addPhysicalGroup(1, lo[1], TARGET_FACE_TAG, name="target_arc")
-        gmsh.model.addPhysicalGroup(1, [lo[2]], SUPPORT_TAG, name="bottom")
+        new_model(gmsh, "two_half_disks", separate=True)
+        up = half_disk(gmsh.model.geo, radius, 1.0)
+        lo = half_disk(gmsh.model.geo, radius, -1.0)
+        gmsh.model.geo.synchronize()
+        _add_pair_groups(
+            gmsh, 2, (up[3], lo[3]),
+            {LOAD_TAG: [up[2]], STRIKER_FACE_TAG: up[1], TARGET_FACE_TAG: lo[1],
+             SUPPORT_TAG: [lo[2]]},
+            ("striker_arc", "target_arc"),
+        )
         field = gmsh.model.mesh.field
         fields = []
-        for tip, arcs, flat, surf, h in (up, lo):
+        for (tip, arcs, flat, surf), h in ((up, h_contact), (lo, h_contact * target_ratio)):
             d = field.add("Distance")
             field.setNumbers(d, "PointsList", [tip])
-            th = field.add("Threshold")
-            field.setNumber(th, "InField", d)
-            field.setNumber(th, "SizeMin", h)
-            field.setNumber(th, "SizeMax", h_far)
-            field.setNumber(th, "DistMin", fine_radius)
-            field.setNumber(th, "DistMax", coarse_radius)
+            th = threshold_field(gmsh, d, h, h_far, fine_radius, coarse_radius)
             r = field.add("Restrict")
             field.setNumber(r, "InField", th)
             field.setNumbers(r, "SurfacesList", [surf])
@@ -90,10 +106,7 @@ def two_half_disks(
             fields.append(r)
         mn = field.add("Min")
         field.setNumbers(mn, "FieldsList", fields)
-        field.setAsBackgroundMesh(mn)
-        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+        size_field_only(gmsh, mn)
         gmsh.option.setNumber("Mesh.Algorithm", 6)
         gmsh.model.mesh.generate(2)
 
@@ -118,9 +131,7 @@ def block_on_block(
     _check(width=width, height=height, n_upper=n_upper, n_lower=n_lower)
 
     def build(gmsh) -> None:
-        gmsh.option.setNumber("General.Verbosity", 0)
-        gmsh.option.setNumber("Geometry.AutoCoherence", 0)  # keep the bodies apart
-        gmsh.model.add("block_on_block")
+        new_model(gmsh, "block_on_block", separate=True)
         geo = gmsh.model.geo
         out = {}
         for name, y0, n in (("lower", 0.0, n_lower), ("upper", height, n_upper)):
@@ -136,13 +147,12 @@ def block_on_block(
         geo.synchronize()
         (lb, _, lt, ll), ls = out["lower"]
         (ub, _, ut, ul), us = out["upper"]
-        gmsh.model.addPhysicalGroup(2, [us], STRIKER_TAG, name="striker")
-        gmsh.model.addPhysicalGroup(2, [ls], TARGET_TAG, name="target")
-        gmsh.model.addPhysicalGroup(1, [ut], LOAD_TAG, name="top")
-        gmsh.model.addPhysicalGroup(1, [ub], STRIKER_FACE_TAG, name="striker_face")
-        gmsh.model.addPhysicalGroup(1, [lt], TARGET_FACE_TAG, name="target_face")
-        gmsh.model.addPhysicalGroup(1, [lb], SUPPORT_TAG, name="bottom")
-        gmsh.model.addPhysicalGroup(1, [ll, ul], SYMMETRY_TAG, name="symmetry")
+        _add_pair_groups(
+            gmsh, 2, (us, ls),
+            {LOAD_TAG: [ut], STRIKER_FACE_TAG: [ub], TARGET_FACE_TAG: [lt], SUPPORT_TAG: [lb]},
+            ("striker_face", "target_face"),
+        )
+        add_groups(gmsh, 1, {SYMMETRY_TAG: ("symmetry", [ll, ul])})
         gmsh.model.mesh.generate(2)
 
     return mesh_on_rank(comm, rank, 2, build)
@@ -166,30 +176,21 @@ def ironing(
     _check(radius=radius, length=length, depth=depth, h_indenter=h_indenter, h_block=h_block)
 
     def build(gmsh) -> None:
-        gmsh.option.setNumber("General.Verbosity", 0)
-        gmsh.option.setNumber("Geometry.AutoCoherence", 0)  # keep the bodies apart
-        gmsh.model.add("ironing")
+        new_model(gmsh, "ironing", separate=True)
         geo = gmsh.model.geo
-        R = radius
-        c = geo.addPoint(0, R, 0, 4 * h_indenter)
-        left = geo.addPoint(-R, R, 0, 4 * h_indenter)
-        tip = geo.addPoint(0, 0, 0, h_indenter)
-        right = geo.addPoint(R, R, 0, 4 * h_indenter)
-        a1, a2 = geo.addCircleArc(left, c, tip), geo.addCircleArc(tip, c, right)
-        flat = geo.addLine(right, left)
-        s_ind = geo.addPlaneSurface([geo.addCurveLoop([a1, a2, flat])])
+        _, arcs, flat, s_ind = half_disk(geo, radius, h_rim=4 * h_indenter, h_tip=h_indenter)
         x0, x1 = -1.0, length - 1.0
         p = [geo.addPoint(x0, -depth, 0, 4 * h_block), geo.addPoint(x1, -depth, 0, 4 * h_block),
              geo.addPoint(x1, 0, 0, h_block), geo.addPoint(x0, 0, 0, h_block)]
         lines = [geo.addLine(p[i], p[(i + 1) % 4]) for i in range(4)]
         s_blk = geo.addPlaneSurface([geo.addCurveLoop(lines)])
         geo.synchronize()
-        gmsh.model.addPhysicalGroup(2, [s_ind], STRIKER_TAG, name="striker")
-        gmsh.model.addPhysicalGroup(2, [s_blk], TARGET_TAG, name="target")
-        gmsh.model.addPhysicalGroup(1, [flat], LOAD_TAG, name="top")
-        gmsh.model.addPhysicalGroup(1, [a1, a2], STRIKER_FACE_TAG, name="striker_arc")
-        gmsh.model.addPhysicalGroup(1, [lines[2]], TARGET_FACE_TAG, name="target_face")
-        gmsh.model.addPhysicalGroup(1, [lines[0]], SUPPORT_TAG, name="bottom")
+        _add_pair_groups(
+            gmsh, 2, (s_ind, s_blk),
+            {LOAD_TAG: [flat], STRIKER_FACE_TAG: arcs, TARGET_FACE_TAG: [lines[2]],
+             SUPPORT_TAG: [lines[0]]},
+            ("striker_arc", "target_face"),
+        )
         gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
         gmsh.option.setNumber("Mesh.Algorithm", 6)
         gmsh.model.mesh.generate(2)
@@ -221,50 +222,22 @@ def two_hemispheres(
     _check(radius=radius, h_contact=h_contact, h_far=h_far)
 
     def build(gmsh) -> None:
-        gmsh.option.setNumber("General.Verbosity", 0)
-        gmsh.model.add("two_hemispheres")
-        occ = gmsh.model.occ
-        R = radius
-        upper, _ = occ.intersect([(3, occ.addSphere(0, 0, R, R))],
-                                 [(3, occ.addBox(0, 0, 0, R, R, R))])
-        lower, _ = occ.intersect([(3, occ.addSphere(0, 0, -R, R))],
-                                 [(3, occ.addBox(0, 0, -R, R, R, R))])
-        occ.synchronize()
-        tol = 1e-6 * R
-        groups: dict[int, list[int]] = {t: [] for t in (LOAD_TAG, STRIKER_FACE_TAG,
-                                                          TARGET_FACE_TAG, SUPPORT_TAG,
-                                                          SYMMETRY_TAG, SYMMETRY_Y_TAG)}
-        for body, curved, flat in ((upper[0], STRIKER_FACE_TAG, LOAD_TAG),
-                                   (lower[0], TARGET_FACE_TAG, SUPPORT_TAG)):
-            for _, tag in gmsh.model.getBoundary([body], oriented=False):
-                x0, y0, z0, x1, y1, z1 = gmsh.model.getBoundingBox(2, tag)
-                if z1 - z0 < tol and abs(abs(z0) - R) < tol:
-                    groups[flat].append(tag)
-                elif x1 - x0 < tol and abs(x0) < tol:
-                    groups[SYMMETRY_TAG].append(tag)
-                elif y1 - y0 < tol and abs(y0) < tol:
-                    groups[SYMMETRY_Y_TAG].append(tag)
-                else:
-                    groups[curved].append(tag)
-        gmsh.model.addPhysicalGroup(3, [upper[0][1]], STRIKER_TAG, name="striker")
-        gmsh.model.addPhysicalGroup(3, [lower[0][1]], TARGET_TAG, name="target")
-        names = {LOAD_TAG: "top", STRIKER_FACE_TAG: "striker_cap", TARGET_FACE_TAG: "target_cap",
-                 SUPPORT_TAG: "bottom", SYMMETRY_TAG: "symmetry_x", SYMMETRY_Y_TAG: "symmetry_y"}
-        for tag, surfaces in groups.items():
-            gmsh.model.addPhysicalGroup(2, surfaces, tag, name=names[tag])
-        field = gmsh.model.mesh.field
-        d = field.add("MathEval")
-        field.setString(d, "F", "Sqrt(x*x + y*y + z*z)")
-        th = field.add("Threshold")
-        field.setNumber(th, "InField", d)
-        field.setNumber(th, "SizeMin", h_contact)
-        field.setNumber(th, "SizeMax", h_far)
-        field.setNumber(th, "DistMin", fine_radius)
-        field.setNumber(th, "DistMax", coarse_radius)
-        field.setAsBackgroundMesh(th)
-        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+        new_model(gmsh, "two_hemispheres")
+        upper, lower = ball_quarters(gmsh, radius, [radius, -radius])
+        up, lo = quarter_faces(gmsh, upper, radius), quarter_faces(gmsh, lower, radius)
+        _add_pair_groups(
+            gmsh, 3, (upper[1], lower[1]),
+            {LOAD_TAG: up["flat"], STRIKER_FACE_TAG: up["curved"],
+             TARGET_FACE_TAG: lo["curved"], SUPPORT_TAG: lo["flat"]},
+            ("striker_cap", "target_cap"),
+        )
+        add_groups(gmsh, 2, {SYMMETRY_TAG: ("symmetry_x", up["x"] + lo["x"]),
+                             SYMMETRY_Y_TAG: ("symmetry_y", up["y"] + lo["y"])})
+        d = gmsh.model.mesh.field.add("MathEval")
+        gmsh.model.mesh.field.setString(d, "F", "Sqrt(x*x + y*y + z*z)")
+        size_field_only(
+            gmsh, threshold_field(gmsh, d, h_contact, h_far, fine_radius, coarse_radius)
+        )
         gmsh.model.mesh.generate(3)
 
     return mesh_on_rank(comm, rank, 3, build)

@@ -31,7 +31,7 @@ from petsc4py import PETSc
 from fenics_contact.model.problem import VariationalSystem
 from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.newton import NewtonKernel
-from fenics_contact.solvers.timing import KernelTimings, stopwatch
+from fenics_contact.solvers.timing import stopwatch
 
 _prefix_counter = itertools.count()
 
@@ -48,17 +48,21 @@ def _owned(space: fem.FunctionSpace) -> int:
 
 
 class CondensedKernel(NewtonKernel):
-    """Newton on (u[, lam]) of a system extended by selected target displacements."""
+    """Newton on (u[, lam]) of a system extended by selected target displacements.
+
+    The Newton step is :meth:`NewtonKernel.newton_step`; the hooks
+    :meth:`_assemble_b` and :meth:`_assemble_A` condense F and J with P.
+    """
+
+    #: A may be a new matrix after a search changed P.
+    _operator_each_step = True
 
     def __init__(
         self, system: VariationalSystem, linear: LinearSolverSettings | None = None
     ) -> None:
-        self.timings = KernelTimings()
-        self.system = system
-        self.unknowns = system.unknowns
+        self._start(system)
         self.extras = system.extras
         self.transfer = system.transfer
-        self.bcs = system.bcs
         ext = [*self.unknowns, *self.extras]
         comm = self.unknowns[0].function_space.mesh.comm
         self._comm = comm
@@ -68,14 +72,10 @@ class CondensedKernel(NewtonKernel):
             blocks = [[_nonempty(f) for f in row] for row in blocks]
             self.J_ext = fem.form(blocks, entity_maps=system.entity_maps)
             self.A_ext = fem_petsc.create_matrix(self.J_ext, kind="mpi")
-            self.spaces = [u.function_space for u in self.unknowns]
             self.ext_spaces = [f.function_space for f in ext]
             self.b_ext = fem_petsc.create_vector(self.ext_spaces, kind="mpi")
-            self.b = fem_petsc.create_vector(self.spaces, kind="mpi")
-            self.x = fem_petsc.create_vector(self.spaces, kind="mpi")
-            self.dx = fem_petsc.create_vector(self.spaces, kind="mpi")
+            self._work_vectors()
             self.z = fem_petsc.create_vector(self.spaces, kind="mpi")
-        self._blocks = self.b.getAttr("_blocks")
         self._prefix = f"fc_{system.name}2_{next(_prefix_counter)}_"
         # Layouts: each rank owns its rows block after block (see linear.block_index_sets).
         n_red = sum(_owned(V) for V in self.spaces)
@@ -99,14 +99,10 @@ class CondensedKernel(NewtonKernel):
         self.P: PETSc.Mat | None = None
         self.A: PETSc.Mat | None = None
         self._P_version = None
-        self.ksp = None
-        self._keep: tuple = ()
         self.linear = linear or LinearSolverSettings()
         self._refresh()
         self._assemble_condensed_jacobian()
         self.set_linear_solver(self.linear)
-        self.linear_solves = 0
-        self.residual_norm = np.inf
         self.rebuilds = 0
 
     # -- selection -------------------------------------------------------------
@@ -173,8 +169,8 @@ class CondensedKernel(NewtonKernel):
         z = self.z.getArray()
         z[self._bc_local] = u[self._bc_local] - self._g[self._bc_local]
 
-    def assemble_residual(self) -> float:
-        """Search, assemble R_ext, condense, set Dirichlet rows; return the norm."""
+    def _assemble_b(self) -> float:
+        """Search, assemble R_ext, condense b = P^T R_ext, set Dirichlet rows; return the norm."""
         self._refresh()
         with stopwatch(self.timings, "residual_s"):
             self._pull()
@@ -188,35 +184,13 @@ class CondensedKernel(NewtonKernel):
             self._boundary_values()
             arr = self.b.getArray()
             arr[self._bc_local] = self.z.getArray(readonly=True)[self._bc_local]
-            self.residual_norm = float(self.b.norm())
-        self.timings.residuals += 1
-        return self.residual_norm
+            return float(self.b.norm())
 
-    def newton_step(self, damping: float = 1.0) -> bool:
-        """Condensed Jacobian, Dirichlet elimination with lifting, solve, update."""
-        t = self.timings
+    def _assemble_A(self) -> None:
+        """Condensed Jacobian A = P^T J_ext P, Dirichlet elimination lifting b."""
         self._assemble_condensed_jacobian()
-        with stopwatch(t, "transfer_s"):
+        with stopwatch(self.timings, "transfer_s"):
             self.A.zeroRowsColumns(self._bc_rows, 1.0, self.z, self.b)
-        try:
-            with stopwatch(t, "setup_s"):
-                self.ksp.setOperators(self.A)
-                self.ksp.setUp()
-                self.ksp.getPC().setUp()
-            with stopwatch(t, "solve_s"):
-                self.ksp.solve(self.b, self.dx)
-        except PETSc.Error:
-            return False
-        self.linear_solves += 1
-        t.linear_solves += 1
-        t.krylov_iterations += self.ksp.getIterationNumber() if self.linear.kind != "direct" else 0
-        if self.ksp.getConvergedReason() < 0:
-            return False
-        if not np.all(np.isfinite(self.dx.getArray(readonly=True))):
-            return False
-        self.x.axpy(-damping, self.dx)
-        self._push()
-        return True
 
     def destroy(self) -> None:
         """Free the PETSc objects."""

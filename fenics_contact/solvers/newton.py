@@ -39,30 +39,41 @@ class NewtonKernel:
         linear: linear solver settings; direct LU (MUMPS) when None.
     """
 
+    #: Hand A to the linear solver again before each solve.
+    _operator_each_step = False
+
     def __init__(
         self, system: VariationalSystem, linear: LinearSolverSettings | None = None
     ) -> None:
-        self.timings = KernelTimings()
-        self.system = system
-        self.unknowns = system.unknowns
-        self.bcs = system.bcs
+        self._start(system)
         with stopwatch(self.timings, "compile_s"):
             self.F = fem.form(system.residuals, entity_maps=system.entity_maps)
             jacobian = fem.forms.derivative_block(system.residuals, system.unknowns)
             self.J = fem.form(jacobian, entity_maps=system.entity_maps)
             self.A = fem_petsc.create_matrix(self.J, kind="mpi")
-            self.spaces = [u.function_space for u in self.unknowns]
-            self.b = fem_petsc.create_vector(self.spaces, kind="mpi")
-            self.x = fem_petsc.create_vector(self.spaces, kind="mpi")
-            self.dx = fem_petsc.create_vector(self.spaces, kind="mpi")
-        self._blocks = self.b.getAttr("_blocks")
+            self._work_vectors()
         self._prefix = f"fc_{system.name}_{next(_prefix_counter)}_"
         self.A.setOptionsPrefix(f"{self._prefix}A_")
+        self.set_linear_solver(linear or LinearSolverSettings())
+
+    def _start(self, system: VariationalSystem) -> None:
+        """The state every kernel starts from: the system, empty timings and counters."""
+        self.timings = KernelTimings()
+        self.system = system
+        self.unknowns = system.unknowns
+        self.bcs = system.bcs
         self.ksp: PETSc.KSP | None = None
         self._keep: tuple = ()
-        self.set_linear_solver(linear or LinearSolverSettings())
         self.linear_solves = 0
         self.residual_norm = np.inf
+
+    def _work_vectors(self) -> None:
+        """Vectors b (residual), x (unknowns) and dx (Newton update) on the unknowns' spaces."""
+        self.spaces = [u.function_space for u in self.unknowns]
+        self.b = fem_petsc.create_vector(self.spaces, kind="mpi")
+        self.x = fem_petsc.create_vector(self.spaces, kind="mpi")
+        self.dx = fem_petsc.create_vector(self.spaces, kind="mpi")
+        self._blocks = self.b.getAttr("_blocks")
 
     # -- linear solver -------------------------------------------------------
     def set_linear_solver(self, settings: LinearSolverSettings) -> None:
@@ -89,14 +100,26 @@ class NewtonKernel:
     # -- Newton ------------------------------------------------------------------
     def assemble_residual(self) -> float:
         """Assemble F at the current unknowns; return and store its norm."""
+        self.residual_norm = self._assemble_b()
+        self.timings.residuals += 1
+        return self.residual_norm
+
+    def _assemble_b(self) -> float:
+        """Hook: the residual F into b (Dirichlet rows x - x_D); return its norm."""
         with stopwatch(self.timings, "residual_s"):
             self._pull()
             fem_petsc.assemble_residual(
                 None, self.x, self.b, self.unknowns, self.F, self.J, self.bcs, self._blocks
             )
-            self.residual_norm = float(self.b.norm())
-        self.timings.residuals += 1
-        return self.residual_norm
+            return float(self.b.norm())
+
+    def _assemble_A(self) -> None:
+        """Hook: the Jacobian at the current unknowns into A, Dirichlet rows set."""
+        with stopwatch(self.timings, "jacobian_s"):
+            fem_petsc.assemble_jacobian(
+                None, self.x, self.A, None, self.unknowns, self.J, None, self.bcs
+            )
+        self.timings.jacobians += 1
 
     def block_norms(self) -> list[float]:
         """Norm of each residual block (after :meth:`assemble_residual`)."""
@@ -116,15 +139,15 @@ class NewtonKernel:
 
         Requires a preceding :meth:`assemble_residual`. Returns False when the
         linear solve fails or produces non-finite values (unknowns untouched).
+        Subclasses change what J and F are through :meth:`_assemble_A` and
+        :meth:`_assemble_b`.
         """
         t = self.timings
-        with stopwatch(t, "jacobian_s"):
-            fem_petsc.assemble_jacobian(
-                None, self.x, self.A, None, self.unknowns, self.J, None, self.bcs
-            )
-        t.jacobians += 1
+        self._assemble_A()
         try:
             with stopwatch(t, "setup_s"):
+                if self._operator_each_step:
+                    self.ksp.setOperators(self.A)
                 self.ksp.setUp()
                 self.ksp.getPC().setUp()
             with stopwatch(t, "solve_s"):

@@ -19,7 +19,7 @@ from mpi4py import MPI
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import SaintVenantKirchhoff
 from fenics_contact.model.obstacles import RigidPlane
-from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
+from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement, ProblemBase
 from fenics_contact.verification.bar import BarOnCradle
 from fenics_contact.verification.paper import PAPER_E, PAPER_NU, PAPER_TABLE_1
 from fenics_contact.verification.striker import StrikerOnFacetProblem
@@ -60,8 +60,39 @@ def _corner_dofs(V: fem.FunctionSpace, value: float) -> np.ndarray:
     return exact.ravel()
 
 
+class _OneElement:
+    """What the one-element examples share: the unit square, its corner, the study's probe.
+
+    A subclass defines ``exact_u``, the exact vertical displacement of the corner (1, 1).
+    """
+
+    exact_u: float
+
+    #: Paper's Table 1, for the study's side-by-side print.
+    published_table = PAPER_TABLE_1
+
+    @staticmethod
+    def _unit_square(comm: MPI.Comm) -> tuple[mesh.Mesh, np.ndarray]:
+        """One quadrilateral [0, 1]^2 and its top facet (local indices)."""
+        domain = mesh.create_unit_square(comm, 1, 1, mesh.CellType.quadrilateral)
+        top = mesh.locate_entities_boundary(domain, 1, lambda x: np.isclose(x[1], 1.0))
+        return domain, top
+
+    def corner_displacement(self, problem: ProblemBase) -> float:
+        """Vertical displacement of the corner (1, 1) (the single unknown)."""
+        return _corner_displacement(problem.V, problem.u)
+
+    def probe(self, problem: ProblemBase) -> float:
+        """What a study reports per run: the corner displacement u."""
+        return self.corner_displacement(problem)
+
+    def exact_dofs(self, problem: ProblemBase) -> np.ndarray:
+        """Dof values of the exact displacement: only the corner moves."""
+        return _corner_dofs(problem.V, self.exact_u)
+
+
 @dataclass(frozen=True)
-class StrikerOnFacet:
+class StrikerOnFacet(_OneElement):
     """The paper's Example 1: a striker node pushes the top facet of one SVK quadrilateral.
 
     Reconstructed geometry (the paper's Figure 1 is not available; see
@@ -97,17 +128,13 @@ class StrikerOnFacet:
         """The exact corner displacement h / striker_at (2 h at the midpoint)."""
         return self.h / self.striker_at
 
-    #: Paper's Table 1, for the study's side-by-side print.
-    published_table = PAPER_TABLE_1
-
     def build(
         self,
         settings: ContactSettings,
         comm: MPI.Comm = MPI.COMM_WORLD,
     ) -> StrikerOnFacetProblem:
         """Create the one-element mesh and the node-to-segment problem."""
-        domain = mesh.create_unit_square(comm, 1, 1, mesh.CellType.quadrilateral)
-        top = mesh.locate_entities_boundary(domain, 1, lambda x: np.isclose(x[1], 1.0))
+        domain, top = self._unit_square(comm)
         return StrikerOnFacetProblem(
             domain,
             SaintVenantKirchhoff(E=PAPER_E, nu=PAPER_NU),
@@ -119,21 +146,8 @@ class StrikerOnFacet:
             energy_quadrature_degree=self.energy_quadrature_degree,
         )
 
-    def corner_displacement(self, problem: StrikerOnFacetProblem) -> float:
-        """Vertical displacement of the corner (1, 1) (the single unknown)."""
-        return _corner_displacement(problem.V, problem.u)
-
-    def probe(self, problem: StrikerOnFacetProblem) -> float:
-        """What a study reports per run: the corner displacement u."""
-        return self.corner_displacement(problem)
-
-    def exact_dofs(self, problem: StrikerOnFacetProblem) -> np.ndarray:
-        """Dof values of the exact displacement: only the corner moves."""
-        return _corner_dofs(problem.V, self.exact_u)
-
-
 @dataclass(frozen=True)
-class WedgeOnCorner:
+class WedgeOnCorner(_OneElement):
     """The former Example 1 analog (``paper-ex1-wedge``): a rigid wedge instead of a striker.
 
     A unit plane-strain quadrilateral [0, 1]^2 is clamped on its left and
@@ -157,9 +171,6 @@ class WedgeOnCorner:
     slope: float = 2.0
     steps: int = 1
 
-    #: Paper's Table 1, for the study's side-by-side print.
-    published_table = PAPER_TABLE_1
-
     @property
     def exact_u(self) -> float:
         """The exact corner displacement, slope * h."""
@@ -171,8 +182,7 @@ class WedgeOnCorner:
         comm: MPI.Comm = MPI.COMM_WORLD,
     ) -> ContactProblem:
         """Create the one-element mesh and the contact problem."""
-        domain = mesh.create_unit_square(comm, 1, 1, mesh.CellType.quadrilateral)
-        top = mesh.locate_entities_boundary(domain, 1, lambda x: np.isclose(x[1], 1.0))
+        domain, top = self._unit_square(comm)
         wedge = RigidPlane(domain, [1.0, 1.0], [-self.slope, -1.0])
         return ContactProblem(
             domain,
@@ -183,19 +193,6 @@ class WedgeOnCorner:
             prescribed=_one_free_corner(domain),
             obstacle_motion=[self.h, 0.0],
         )
-
-    def corner_displacement(self, problem: ContactProblem) -> float:
-        """Vertical displacement of the top-right corner (the single unknown)."""
-        return _corner_displacement(problem.V, problem.u)
-
-    def probe(self, problem: ContactProblem) -> float:
-        """What a study reports per run: the corner displacement u."""
-        return self.corner_displacement(problem)
-
-    def exact_dofs(self, problem: ContactProblem) -> np.ndarray:
-        """Dof values of the exact displacement: only the corner moves."""
-        return _corner_dofs(problem.V, self.exact_u)
-
 
 #: Examples the ``study`` command knows, by name.
 EXAMPLES: dict[str, type] = {

@@ -37,8 +37,6 @@ import numpy as np
 import ufl
 from dolfinx import default_scalar_type, fem, mesh
 
-from mpi4py import MPI
-
 from fenics_contact.model.contact import (
     CONTACT_TAG,
     ContactSettings,
@@ -293,19 +291,8 @@ class StrikerOnFacetProblem(ProblemBase):
         """Gap, transmitted force min(lam + r g, 0) (<= 0, per unit thickness) and summaries."""
         gap = self._values(self._gap_form)
         pressure = self._values(self._pressure_form)
-        multiplier = self.lam.x.array[: gap.size].copy()
-        active = pressure < 0.0
-        comm = self.comm
-        return ContactState(
-            gap=gap,
-            pressure=pressure,
-            multiplier=multiplier,
-            active=active,
-            active_count=comm.allreduce(int(active.sum()), op=MPI.SUM),
-            max_penetration=comm.allreduce(
-                float(np.max(-np.minimum(gap, 0.0), initial=0.0)) + 0.0, op=MPI.MAX
-            ),
-            contact_force=comm.allreduce(float(-pressure.sum()), op=MPI.SUM),
+        return ContactState.gathered(
+            self.comm, gap, pressure, self.lam.x.array[: gap.size].copy(), float(-pressure.sum())
         )
 
     def active_signature(self) -> tuple[bytes, ...]:
