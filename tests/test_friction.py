@@ -169,6 +169,36 @@ def test_shipped_path_costs_at_most_twice_a_frictionless_increment(gnrm_run):
             assert history[-1] / history[-2] < 1e-3
 
 
+@pytest.mark.parametrize("method", ["gnrm", "auto", "sua", "nua"])
+def test_residual_measure_includes_the_tangential_complementarity(method):
+    """Issue item 2: every multiplier strategy's stopping norm sees lam_t off the Coulomb law."""
+    problem, _ = solve(mu=MU)  # ends sliding: lam_t = -mu p sign(slip) at every node
+    strategy = make_strategy(method, problem, SolverSettings(atol=1e-8))
+    converged = strategy.residual_norm()
+    assert converged < 1e-8
+    normal, tangential = problem.complementarity_norms()
+    assert normal < 1e-8 and tangential < 1e-8
+    problem.lam_t.x.array[:] *= 1.5  # off the disc; the trial direction (slip) is unchanged
+    normal, tangential = problem.complementarity_norms()
+    assert normal < 1e-8 and tangential > 1e-3
+    # the equilibrium block is unchanged (tau is still mu p in the slip direction)
+    assert strategy.residual_norm() == pytest.approx(np.hypot(converged, tangential), rel=1e-6)
+
+
+def test_auto_penalty_warm_start_keeps_the_tangential_multiplier():
+    """``auto`` borrows the penalty system; committing must not replace lam_t by its traction."""
+    problem, _ = solve(mu=MU)
+    lam_t = problem.lam_t.x.array.copy()
+    assert np.max(np.abs(lam_t)) > 1.0
+    make_strategy("auto", problem, SolverSettings())
+    problem.penalty_system()  # what auto's penalty warm start compiles
+    problem.commit()
+    assert np.array_equal(problem.lam_t.x.array, lam_t)
+    make_strategy("penalty", problem, SolverSettings())  # the penalty method keeps its history
+    problem.commit()  # penalty disc radius mu r max(-g, 0) = 0 at this exactly closed contact
+    assert np.max(np.abs(problem.lam_t.x.array)) < 1e-6 * np.max(np.abs(lam_t))
+
+
 def test_mu_zero_reproduces_frictionless_exactly():
     p0, run0 = solve(mu=None)
     p1, run1 = solve(mu=0.0)
