@@ -46,3 +46,25 @@ def test_stability_command_writes_csv_plot_and_step_records(tmp_path):
                for r in rows for v in r.values())
     assert (tmp_path / "stability.png").stat().st_size > 5_000
     assert len(list((tmp_path / "cases").glob("*.json"))) == 4
+
+
+def test_tradeoff_friction_group_scores_the_coulomb_law(tmp_path):
+    code = main(["tradeoff", "--scene", "friction", "--mu", "0.3", "--methods", "penalty,gnrm",
+                 "--r", "1,1e4", "--meshes", "1", "--repeats", "1", "--out", str(tmp_path)])
+    assert code == 0
+    rows = {(r["method"], float(r["r_relative"])): r for r in read_csv(tmp_path / "tradeoff.csv")}
+    assert len(rows) == 4
+    assert {"mu", "ft_error", "stick_slip", "t_residual"} <= set(rows[("gnrm", 1.0)])
+    for r in (1.0, 1e4):  # GNRM: the nodal Coulomb law holds whatever r (measured 3e-16)
+        gnrm = rows[("gnrm", r)]
+        assert gnrm["status"] == "converged" and float(gnrm["mu"]) == 0.3
+        assert float(gnrm["ft_error"]) < 1e-12 and float(gnrm["stick_slip"]) < 1e-12
+        assert float(gnrm["u_error"]) < 1e-12 and float(gnrm["t_residual"]) < 1e-8
+    # penalty at r = 1 E/h (r_t = 0.1 E/h): sticking nodes creep (measured 1.3e-3 against a
+    # 0.02 slide) and it slides fully later than the reference (F_t 15 % below mu N there)
+    penalty = rows[("penalty", 1.0)]
+    assert penalty["status"] == "converged" and penalty["t_residual"] == "nan"  # no lam_t
+    assert float(penalty["stick_slip"]) > 1e-4 and float(penalty["ft_error"]) > 0.05
+    table = (tmp_path / "table.md").read_text()
+    assert "| slide | 10x5 | 0.3 | GNRM | 1 - 10000 |" in table
+    assert (tmp_path / "tradeoff.png").stat().st_size > 10_000

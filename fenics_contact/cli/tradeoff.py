@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 from fenics_contact.cli.study import floats, methods
@@ -24,15 +25,17 @@ def _tradeoff(args: argparse.Namespace) -> int:
         done.append(rec)
         write_csv(out / "tradeoff.csv", [r.row() for r in done])  # survives a crash
         if rank0:
+            last = (f"p0 err {rec.p0_error:.1e}" if math.isnan(rec.mu) else
+                    f"Ft err {rec.ft_error:.1e}  stick slip {rec.stick_slip:.1e}")
             print(
-                f"  {rec.scene:5s} {rec.mesh:9s} {rec.method:8s} r = {rec.r_relative:<8g} "
+                f"  {rec.case:11s} {rec.mesh:9s} {rec.method:8s} r = {rec.r_relative:<8g} "
                 f"{rec.status:15s} it {rec.iterations:5d}  {rec.wall_s:7.3f} s  "
-                f"u err {rec.u_error:.1e}  p0 err {rec.p0_error:.1e}",
+                f"u err {rec.u_error:.1e}  {last}",
                 flush=True,
             )
 
     records = run_tradeoff(
-        args.scene, args.methods, args.r, meshes=args.meshes, progress=show,
+        args.scene, args.methods, args.r, meshes=args.meshes, mu=args.mu, progress=show,
         repeats=args.repeats, max_iterations=args.max_iterations,
     )
     table = markdown_table(records)
@@ -49,26 +52,55 @@ def _tradeoff(args: argparse.Namespace) -> int:
 
 
 def _scenes(text: str) -> list[str]:
-    names = [s.strip().lower() for s in text.split(",") if s.strip()]
-    bad = [s for s in names if s not in ("hertz", "bar")]
+    """Scene names, with the groups 'frictionless', 'friction' and 'all' expanded."""
+    from fenics_contact.studies.tradeoff import FRICTION_SCENES, FRICTIONLESS_SCENES
+
+    groups = {"frictionless": FRICTIONLESS_SCENES, "friction": FRICTION_SCENES,
+              "all": FRICTIONLESS_SCENES + FRICTION_SCENES}
+    known = FRICTIONLESS_SCENES + FRICTION_SCENES
+    names: list[str] = []
+    for name in (s.strip().lower() for s in text.split(",") if s.strip()):
+        names += groups.get(name, (name,))
+    bad = [s for s in names if s not in known]
     if bad or not names:
-        raise argparse.ArgumentTypeError(f"unknown scene(s) {bad or text!r}; use hertz,bar")
-    return names
+        raise argparse.ArgumentTypeError(
+            f"unknown scene(s) {bad or text!r}; use {','.join(known)} or a group: "
+            f"{','.join(groups)}"
+        )
+    return list(dict.fromkeys(names))
+
+
+def _coefficients(text: str) -> list[float]:
+    """Comma-separated Coulomb coefficients, each finite and > 0."""
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        values = []
+    if not values or not all(0 < v < float("inf") for v in values):
+        raise argparse.ArgumentTypeError(
+            f"--mu takes comma-separated friction coefficients > 0 such as 0.1,0.3,1, got {text!r}"
+        )
+    return values
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``tradeoff`` subcommand."""
-    from fenics_contact.studies.tradeoff import FULL_R, METHODS
+    from fenics_contact.studies.tradeoff import FRICTION_MU, FULL_R, METHODS
 
     cmd = sub.add_parser(
         "tradeoff",
         help="measure wall time against accuracy over methods x r x meshes",
         description="Sweep methods x r (relative to E/h) x meshes on the Hertz cylinder and "
-        "the Example 2 bar; write tradeoff.json, tradeoff.csv, table.md and tradeoff.png "
+        "the Example 2 bar, and with Coulomb friction on the sliding block (scene 'slide', "
+        "one case per mu); write tradeoff.json, tradeoff.csv, table.md and tradeoff.png "
         "(error against time, Pareto front marked).",
     )
     cmd.add_argument("--scene", type=_scenes, default=["hertz", "bar"],
-                     help="comma-separated scenes: hertz,bar (default both)")
+                     help="comma-separated scenes hertz,bar,slide or groups frictionless "
+                     "(hertz,bar), friction (slide), all (default frictionless)")
+    cmd.add_argument("--mu", type=_coefficients, default=list(FRICTION_MU),
+                     help="Coulomb coefficients of the friction cases (default "
+                     f"{','.join(f'{m:g}' for m in FRICTION_MU)})")
     cmd.add_argument("--methods", type=methods, default=list(METHODS),
                      help="comma-separated strategies (default penalty,sua,nua,gnrm,auto)")
     cmd.add_argument("--r", type=floats, default=list(FULL_R),

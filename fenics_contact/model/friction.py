@@ -198,7 +198,6 @@ class FrictionalContactProblem(ContactProblem):
         self.penalty_traction = coulomb_projection(
             self.trial_traction, self._penalty_radius, self.eps
         )
-        self._penalty_commit = False
 
         k = gdim - 1
         self._tau_forms = [self.surface.nodal_form(self.traction_t[i]) for i in range(k)]
@@ -225,10 +224,12 @@ class FrictionalContactProblem(ContactProblem):
     def commit(self) -> None:
         """Accept the converged increment: u_prev <- u, c_prev <- c.
 
-        After a penalty solve the committed tangential traction is kept in
-        lam_t (the regularised-stick history); AL methods already hold it there.
+        When the penalty method solves the problem (``multiplier_is_pressure``
+        False) the committed tangential traction is kept in lam_t (the
+        regularised-stick history); AL methods already hold it there, and so
+        does ``auto`` after a penalty warm start (it only borrows the system).
         """
-        if self._penalty_commit:
+        if not self.multiplier_is_pressure:
             self._set_lam_t(self._nodal_components(self._pen_forms))
         self.u_prev.x.array[:] = self.u.x.array
         self.c_prev.value[:] = self.obstacle.point.value
@@ -287,7 +288,6 @@ class FrictionalContactProblem(ContactProblem):
         residual = ufl.derivative(energy, self.u, v) + self._tangential_work(
             self.penalty_traction
         )
-        self._penalty_commit = True
         return VariationalSystem(
             "penalty_friction", [residual], [self.u], self.bcs, self.surface.entity_maps
         )

@@ -64,19 +64,22 @@ def _panel(ax: plt.Axes, recs: Sequence[TradeoffRecord], field: str, front: str)
 
 
 def tradeoff_plot(records: Sequence[TradeoffRecord], path: Path) -> None:
-    """One panel per scene (displacement error vs time), plus Hertz peak error vs time."""
+    """One panel per case (displacement error vs time), plus Hertz peak error vs time.
+
+    A case is a scene, or a friction scene at one Coulomb coefficient.
+    """
     panels: list[tuple[str, str, str]] = []
-    for scene in dict.fromkeys(r.scene for r in records):
-        panels.append((scene, "u_error", "pareto_u"))
-        if any(math.isfinite(r.p0_error) for r in records if r.scene == scene):
-            panels.append((scene, "p0_error", "pareto_p0"))
+    for case in dict.fromkeys(r.case for r in records):
+        panels.append((case, "u_error", "pareto_u"))
+        if any(math.isfinite(r.p0_error) for r in records if r.case == case):
+            panels.append((case, "p0_error", "pareto_p0"))
     fig, axes = plt.subplots(1, len(panels), figsize=(5.2 * len(panels), 4.4), squeeze=False)
-    for ax, (scene, field, front) in zip(axes[0], panels, strict=True):
-        _panel(ax, [r for r in records if r.scene == scene], field, front)
+    for ax, (case, field, front) in zip(axes[0], panels, strict=True):
+        _panel(ax, [r for r in records if r.case == case], field, front)
         what = ("displacement error vs tight GNRM (rel. L2)" if field == "u_error"
                 else "peak-pressure error vs Hertz (rel.)")
         ax.set_ylabel(what)
-        ax.set_title(f"{scene}: {'per mesh' if front == 'pareto_u' else 'all meshes'}", fontsize=9)
+        ax.set_title(f"{case}: {'per mesh' if front == 'pareto_u' else 'all meshes'}", fontsize=9)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=120)

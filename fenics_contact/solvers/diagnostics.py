@@ -25,7 +25,7 @@ converged but det F <= 0 somewhere in the body, so the step is refused) and
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Hashable
+from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
 
@@ -160,6 +160,23 @@ class ConvergenceMonitor:
                 if states[j] == states[i] and any(states[k] != states[i] for k in range(i + 1, j)):
                     return True
         return False
+
+
+def convergence_order(residuals: Sequence[float], floor: float = 0.0) -> float:
+    """Estimated order of convergence from the last three residuals above ``floor``.
+
+    q = log(r_k / r_(k-1)) / log(r_(k-1) / r_(k-2)): 1 for linear, 2 for
+    quadratic convergence, > 1 superlinear. Residuals at or below ``floor``
+    (the round-off level, force units) are left out; NaN when fewer than
+    three remain or they do not decrease.
+    """
+    usable = [r for r in residuals if r > floor and math.isfinite(r)]
+    if len(usable) < 3:
+        return math.nan
+    r0, r1, r2 = usable[-3:]
+    if not r0 > r1 > r2:
+        return math.nan
+    return math.log(r2 / r1) / math.log(r1 / r0)
 
 
 @dataclass(frozen=True)

@@ -25,6 +25,9 @@ from fenics_contact.model.problem import PrescribedDisplacement
 PRESS_SLIDE = ((0.0, 0.0, 0.0), (0.4, 0.0, 0.01), (1.0, 0.02, 0.01))
 #: Press, slide +0.02, then back to -0.01: the friction force reverses.
 REVERSAL = ((0.0, 0.0, 0.0), (0.3, 0.0, 0.01), (0.65, 0.02, 0.01), (1.0, -0.01, 0.01))
+#: Press up by 0.01, then slide by 0.02 while pressing on to 0.015: every step
+#: changes the normal state too, so a frictionless run has work in every step.
+OBLIQUE = ((0.0, 0.0, 0.0), (0.4, 0.0, 0.01), (1.0, 0.02, 0.015))
 
 
 @dataclass(frozen=True)
