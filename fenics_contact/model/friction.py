@@ -125,6 +125,9 @@ class FrictionalContactState(ContactState):
         coulomb_limit: nodal disc radius rho = -mu p_n (stress).
         node_state: 0 open, 1 stick, 2 slip, per owned node.
         tangential_force: global |int T tau dA| (force; per thickness in 2D).
+        tangential_magnitude: global int |tau| dA (force): each node's traction
+            in its own frame, so mu times the normal force where every node slips,
+            whatever the tilt of the contact surface.
         stick_count: global number of sticking contact nodes.
         slip_count: global number of slipping contact nodes.
     """
@@ -134,6 +137,7 @@ class FrictionalContactState(ContactState):
     coulomb_limit: np.ndarray = field(default_factory=lambda: np.zeros(0))
     node_state: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int8))
     tangential_force: float = 0.0
+    tangential_magnitude: float = 0.0
     stick_count: int = 0
     slip_count: int = 0
 
@@ -227,6 +231,10 @@ class FrictionMixin:
             fem.form(force[i] * self.surface.ds, entity_maps=self.surface.entity_maps)
             for i in range(gdim)
         ]
+        self._tmag_form = fem.form(
+            ufl.sqrt(ufl.dot(self.traction_t, self.traction_t)) * self.surface.ds,
+            entity_maps=self.surface.entity_maps,
+        )
 
     def _slip_increment(self) -> tuple[ufl.core.expr.Expr, ufl.core.expr.Expr]:
         """(T, dg_t): the gdim x (d-1) tangent matrix and the slip increment (length)."""
@@ -383,6 +391,9 @@ class FrictionMixin:
             coulomb_limit=self.surface.nodal(self._rho_form),
             node_state=states,
             tangential_force=float(np.linalg.norm(self.tangential_force_vector())),
+            tangential_magnitude=comm.allreduce(
+                fem.assemble_scalar(self._tmag_form), op=MPI.SUM
+            ),
             stick_count=comm.allreduce(int(np.sum(states == STICK)), op=MPI.SUM),
             slip_count=comm.allreduce(int(np.sum(states == SLIP)), op=MPI.SUM),
         )
