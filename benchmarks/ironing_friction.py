@@ -14,8 +14,16 @@ Ratios, per step:
 - ``ploughing_ratio``: the same for the frictionless run, the horizontal
   force that the block's bow wave (the tilt of the contact patch) gives
   without any friction;
-- ``corrected_ratio`` = tan(atan(reaction_ratio) - atan(ploughing_ratio)):
-  the reaction with the ploughing tilt of the frictionless run rotated out;
+- ``normal_tilt_deg``: the angle phi of the resultant normal contact force on
+  the indenter from the vertical (positive: it pushes the indenter back, the
+  ploughing resistance). The resultant is F_n = F_c - F_f, with F_c = -R the
+  whole contact force and F_f = -int T tau dA the friction force;
+- ``resultant_ratio`` = |F_f| / |F_n|: in 2D, with every node slipping the
+  same way, the friction resultant is the normal resultant turned by 90
+  degrees times mu, so this is mu and R_x / -R_y = tan(phi + atan(mu)):
+  the whole offset of the reaction ratio from mu is the tilt phi;
+- ``corrected_ratio`` = tan(atan(reaction_ratio) - phi): the reaction ratio
+  with the tilt of the normal resultant rotated out;
 - ``frame_ratio`` = F_t / N: tangential over normal contact force in the
   contact frame (mu wherever every contact node slips).
 
@@ -88,6 +96,9 @@ def run(mu: float | None, coarse: bool) -> dict:
     def on_step(step) -> None:
         force = problem.reaction(top)
         state = problem.contact_state()
+        friction = (-problem.tangential_force_vector() if hasattr(problem, "lam_t")
+                    else np.zeros(2))
+        normal = -force - friction
         rows.append({
             "step": step.step, "load_factor": step.load_factor,
             "slide_over_R": float(np.interp(step.load_factor, knots[:, 0], knots[:, 1])) / RADIUS,
@@ -95,6 +106,8 @@ def run(mu: float | None, coarse: bool) -> dict:
             "reaction_ratio": float(force[0] / -force[1]),
             "normal_force": step.contact_force,
             "frame_tangential_force": float(getattr(state, "tangential_magnitude", 0.0)),
+            "normal_tilt_deg": float(np.degrees(np.arctan2(-normal[0], normal[1]))),
+            "resultant_ratio": float(np.linalg.norm(friction) / np.linalg.norm(normal)),
             "stick": step.stick_count, "slip": step.slip_count, "active": step.active_count,
             "iterations": step.iterations, "order": order(step.residuals[-1]),
             "max_penetration": step.max_penetration, "residuals": step.residuals[-1],
@@ -122,8 +135,10 @@ def main() -> None:
     for row, ref in zip(friction["rows"], plain["rows"], strict=False):
         row["ploughing_ratio"] = ref["reaction_ratio"]
         row["iterations_frictionless"] = ref["iterations"]
+        row["ploughing_tilt_deg"] = ref["normal_tilt_deg"]
+        row["order_frictionless"] = ref["order"]
         row["corrected_ratio"] = math.tan(
-            math.atan(row["reaction_ratio"]) - math.atan(ref["reaction_ratio"]))
+            math.atan(row["reaction_ratio"]) - math.radians(row["normal_tilt_deg"]))
         row["frame_ratio"] = row["frame_tangential_force"] / row["normal_force"]
     rows = friction["rows"]
     steady = [r for r in rows if STEADY[0] <= r["slide_over_R"] <= STEADY[1]
@@ -133,15 +148,24 @@ def main() -> None:
         values = [r[key] for r in steady]
         return (min(values), max(values)) if values else (math.nan, math.nan)
 
+    pairs = [0.5 * (a["reaction_ratio"] + b["reaction_ratio"])
+             for a, b in zip(steady[::2], steady[1::2], strict=False)]
     press = [r for r in rows if r["slide_over_R"] == 0.0]
     slide = [r for r in rows if r["slide_over_R"] > 0.0]
     tails = [r["order"] for r in slide if not math.isnan(r["order"])]
+    tails0 = [r["order"] for r in plain["rows"][len(press):] if not math.isnan(r["order"])]
     summary = {
         "mu": mu, "coarse": args.coarse, "status": friction["status"],
         "status_frictionless": plain["status"],
         "steady_window_slide_over_R": STEADY, "steady_steps": len(steady),
         "reaction_ratio": span("reaction_ratio"), "ploughing_ratio": span("ploughing_ratio"),
         "corrected_ratio": span("corrected_ratio"), "frame_ratio": span("frame_ratio"),
+        "resultant_ratio": span("resultant_ratio"), "normal_tilt_deg": span("normal_tilt_deg"),
+        "ploughing_tilt_deg": span("ploughing_tilt_deg"),
+        "mean_reaction_ratio": float(np.mean([r["reaction_ratio"] for r in steady])),
+        "mean_ploughing_ratio": float(np.mean([r["ploughing_ratio"] for r in steady])),
+        "mean_normal_tilt_deg": float(np.mean([r["normal_tilt_deg"] for r in steady])),
+        "two_step_mean_reaction_ratio": (min(pairs), max(pairs)) if pairs else (math.nan,) * 2,
         "all_slip_in_window": all(r["stick"] == 0 for r in steady),
         "iterations": friction["iterations"], "iterations_frictionless": plain["iterations"],
         "max_step_iterations": max(r["iterations"] for r in rows),
@@ -151,6 +175,7 @@ def main() -> None:
         "press_iterations": [r["iterations"] for r in press],
         "median_order_sliding": float(np.median(tails)) if tails else math.nan,
         "min_order_sliding": float(np.min(tails)) if tails else math.nan,
+        "median_order_sliding_frictionless": float(np.median(tails0)) if tails0 else math.nan,
         "max_penetration_over_R": max(r["max_penetration"] for r in rows) / RADIUS,
     }
     if MPI.COMM_WORLD.rank != 0:
@@ -161,7 +186,15 @@ def main() -> None:
          ["steps in the steady window", summary["steady_steps"]],
          ["reaction ratio R_x/-R_y (min, max)", interval(summary["reaction_ratio"], 4)],
          ["frictionless (ploughing) ratio", interval(summary["ploughing_ratio"], 4)],
-         ["ploughing-corrected ratio", interval(summary["corrected_ratio"], 4)],
+         ["mean reaction ratio in the window", summary["mean_reaction_ratio"]],
+         ["mean of two consecutive steps (min, max)",
+          interval(summary["two_step_mean_reaction_ratio"], 4)],
+         ["mean frictionless ratio in the window", summary["mean_ploughing_ratio"]],
+         ["tilt of the normal resultant, deg (min, max; mean)",
+          f"{interval(summary['normal_tilt_deg'], 3)}; {summary['mean_normal_tilt_deg']:.3f}"],
+         ["frictionless tilt, deg (min, max)", interval(summary["ploughing_tilt_deg"], 3)],
+         ["friction / normal resultant |F_f| / |F_n|", interval(summary["resultant_ratio"], 8)],
+         ["reaction ratio with the tilt rotated out", interval(summary["corrected_ratio"], 8)],
          ["frame ratio int|tau| / N", interval(summary["frame_ratio"], 6)],
          ["every contact node slips in the window", summary["all_slip_in_window"]],
          ["Newton iterations (friction / frictionless)",
@@ -171,6 +204,7 @@ def main() -> None:
          ["max per-step ratio friction / frictionless", summary["max_ratio_per_step"]],
          ["order of the last iterations while sliding (median, min)",
           f"{summary['median_order_sliding']:.2f}, {summary['min_order_sliding']:.2f}"],
+         ["same, frictionless (median)", summary["median_order_sliding_frictionless"]],
          ["max penetration / R", summary["max_penetration_over_R"]]],
     )
     text = f"# Ironing with friction (mu = {mu}, GNRM)\n\n{table}\n"
@@ -202,7 +236,7 @@ def picture(rows: list[dict], mu: float, path: Path) -> None:
     ax.plot(s, [r["ploughing_ratio"] for r in rows], "s-", ms=3,
             label="R_x / -R_y frictionless (ploughing)")
     ax.plot(s, [r["corrected_ratio"] for r in rows], "^-", ms=3,
-            label="ploughing tilt rotated out")
+            label="tilt of the normal resultant rotated out")
     ax.plot(s, [r["frame_ratio"] for r in rows], "k--", lw=1, label="int |tau| / N (contact frame)")
     ax.axvspan(*STEADY, color="#1f77b4", alpha=0.06, label="steady window")
     ax.set_xlabel("slide / R")

@@ -195,3 +195,38 @@ def test_scene_pair_takes_mu(tmp_path):
     with pytest.raises(SceneError, match=r"friction fields need \[\[pair\]\] mu"):
         load_scene(plain)
     assert dataclasses.replace(scene.pairs[0], mu=None).mu is None
+
+
+def test_ironing_friction_scene_writes_friction_output(tmp_path):
+    """A short, coarse ironing_friction run: friction fields, forces and counts per step."""
+    import json
+
+    from fenics_contact.runner import run_scene
+    from fenics_contact.scene.schema import load_scene
+
+    root = Path(__file__).resolve().parents[1]
+    scene = load_scene(root / "scenes" / "ironing_friction.toml")
+    path = ((0.0, 0.0, 0.0), (0.5, 0.0, -0.06), (1.0, 0.24, -0.06))
+    scene = dataclasses.replace(
+        scene,
+        mesh=dataclasses.replace(scene.mesh, parameters={"h_indenter": 0.08, "h_block": 0.12}),
+        dirichlet=(scene.dirichlet[0], dataclasses.replace(scene.dirichlet[1], path=path)),
+        solver=dataclasses.replace(scene.solver, steps=6),
+    )
+    outcome = run_scene(scene, tmp_path, pictures=True)
+    assert outcome.path.converged
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    last = summary["steps"][-1]
+    assert summary["pairs"][0]["mu"] == 0.3
+    assert summary["pairs"][0]["steps"][-1]["slip_count"] == last["slip_count"]
+    assert last["slip_count"] > 0 and last["stick_count"] == 0
+    # every node slips: the friction resultant is mu times the normal one (2D)
+    state = outcome.problem.contact_state()
+    assert state.tangential_magnitude == pytest.approx(0.3 * state.contact_force, rel=1e-8)
+    assert last["tangential_force"] == pytest.approx(state.tangential_force, rel=1e-12)
+    index = (tmp_path / "solution.xdmf").read_text()
+    step = sorted((tmp_path / "solution").glob("*.xdmf"))[-1].read_text()
+    assert "Time" in index
+    for name in ("tangential_traction", "slip", "stick_slip", "target_contact_force"):
+        assert f'Name="{name}"' in step, name
+    assert (tmp_path / "friction.png").stat().st_size > 0
