@@ -43,6 +43,7 @@ from pathlib import Path
 
 import harness
 import numpy as np
+from ironing import order
 
 from mpi4py import MPI
 
@@ -56,22 +57,11 @@ from fenics_contact.solvers.stepping import solve_load_path
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "scenes" / "ironing_friction.toml"
-#: Residuals below this are at round-off and left out of the order estimate.
-FLOOR = 1e-11
 #: Indenter radius (meshes/ironing.geo).
 RADIUS = 0.5
 #: Steady sliding: slide / R in this window (after the stick-to-slip transition,
 #: before the indenter nears the block's far end).
 STEADY = (0.6, 2.4)
-
-
-def order(residuals: list[float]) -> float:
-    """Estimated order from the last three residuals above FLOOR (nan if fewer)."""
-    r = [v for v in residuals if v > FLOOR]
-    if len(r) < 3:
-        return float("nan")
-    a, b, c = r[-3:]
-    return float(np.log(c / b) / np.log(b / a))
 
 
 def run(mu: float | None, coarse: bool) -> dict:

@@ -136,7 +136,7 @@ def test_gnrm_answer_does_not_depend_on_r(gnrm_run):
     reference, _, _, _ = gnrm_run
     u_ref = reference.u.x.array
     scale = np.max(np.abs(u_ref))
-    for r in (1e-2, 1e-1, 1e1, 1e2):
+    for r in (1e-2, 1e2):  # measured also at 0.1 and 10 E/h (docs/friction.md)
         problem, _, run, _ = solve(r=r)
         assert run.converged, r
         assert np.max(np.abs(problem.u.x.array - u_ref)) < 1e-8 * scale, r
@@ -161,18 +161,21 @@ def test_target_reaction_equals_striker_reaction(gnrm_run):
     np.testing.assert_allclose(total, top, atol=1e-10 * scale)
 
 
-@pytest.mark.parametrize(("method", "iterations"), [("nua", 400), ("penalty", 50)])
-def test_uzawa_and_penalty(gnrm_run, method: str, iterations: int):
-    """Nested Uzawa converges to the GNRM answer; penalty slides at mu times its own N."""
+@pytest.mark.parametrize(("method", "iterations"), [("nua", 400), ("penalty", 50), ("auto", 50)])
+def test_other_strategies(gnrm_run, method: str, iterations: int):
+    """Nested Uzawa and auto give the GNRM answer; penalty slides at mu times its own N."""
     reference, _, _, _ = gnrm_run
     problem, _, run, states = solve(method, max_iterations=iterations)
     assert run.converged
     final = states[-1]
     assert final.slip_count == final.active_count == 7
     assert final.tangential_magnitude == pytest.approx(MU * final.contact_force, rel=1e-8)
-    if method == "nua":
-        u_ref = reference.u.x.array
+    u_ref = reference.u.x.array
+    if method == "nua":  # linear tangential Uzawa: measured 245-300 iterations while sticking
         assert np.max(np.abs(problem.u.x.array - u_ref)) < 1e-6 * np.max(np.abs(u_ref))
+    elif method == "auto":
+        assert [s.iterations for s in run.steps] == SERIAL_ITERATIONS
+        assert np.max(np.abs(problem.u.x.array - u_ref)) < 1e-10 * np.max(np.abs(u_ref))
 
 
 def test_scene_pair_takes_mu(tmp_path):

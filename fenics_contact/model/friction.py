@@ -181,6 +181,14 @@ class FrictionMixin:
     pressure: ufl.core.expr.Expr
     gap: ufl.core.expr.Expr
 
+    def __init__(
+        self, *args, mu: float, tangential_r_max: float | None = 0.1, **kwargs
+    ) -> None:
+        """Check mu and the cap, build the host problem, then the friction terms."""
+        check_friction(mu, tangential_r_max)
+        super().__init__(*args, **kwargs)
+        self._init_friction(mu, tangential_r_max)
+
     def _init_friction(self, mu: float, tangential_r_max: float | None) -> None:
         """Create lam_t, u_prev, the slip, the projected traction and the nodal forms."""
         domain = self.domain
@@ -418,13 +426,6 @@ class FrictionalContactProblem(FrictionMixin, ContactProblem):
     r_t = min(r, tangential_r_max E/h) (None: r_t = r). Other arguments as
     :class:`ContactProblem`.
     """
-
-    def __init__(
-        self, *args, mu: float, tangential_r_max: float | None = 0.1, **kwargs
-    ) -> None:
-        check_friction(mu, tangential_r_max)
-        super().__init__(*args, **kwargs)
-        self._init_friction(mu, tangential_r_max)
 
     def _slip_increment(self) -> tuple[ufl.core.expr.Expr, ufl.core.expr.Expr]:
         """T from the obstacle normal; dg_t = T^T [(x - x_prev) - (c - c_prev)]."""

@@ -36,7 +36,7 @@ from __future__ import annotations
 import ufl
 from dolfinx import fem
 
-from fenics_contact.model.friction import FrictionMixin, check_friction, tangent_basis
+from fenics_contact.model.friction import FrictionMixin, tangent_basis
 from fenics_contact.model.pairs import TwoBodyProblem
 
 
@@ -48,13 +48,6 @@ class FrictionalTwoBodyProblem(FrictionMixin, TwoBodyProblem):
     :meth:`commit` moves u_prev and the target's previous displacements
     forward; the stepping calls it before each increment.
     """
-
-    def __init__(
-        self, *args, mu: float, tangential_r_max: float | None = 0.1, **kwargs
-    ) -> None:
-        check_friction(mu, tangential_r_max)
-        super().__init__(*args, **kwargs)
-        self._init_friction(mu, tangential_r_max)
 
     def _slip_increment(self) -> tuple[ufl.core.expr.Expr, ufl.core.expr.Expr]:
         """T of the target facet and the relative slip of the contacting points."""
