@@ -51,10 +51,13 @@ def _summary(scene: Scene, record: RunRecord) -> dict:
         "pairs": [
             {
                 "name": pair.name, "striker": pair.striker, "target": pair.target,
+                "mu": pair.mu,
                 "steps": [
                     {"step": s.step, "load_factor": s.load_factor,
                      "normal_force": s.contact_force, "active_count": s.active_count,
-                     "max_penetration": s.max_penetration}
+                     "max_penetration": s.max_penetration,
+                     **({"tangential_force": s.tangential_force, "stick_count": s.stick_count,
+                         "slip_count": s.slip_count} if pair.mu is not None else {})}
                     for s in record.steps
                 ],
             }

@@ -256,13 +256,20 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> TwoBodyProblem:
         )
         for i, spec in enumerate(scene.tractions)
     ]
-    return TwoBodyProblem(
+    args = (
         body.domain, body.cell_tags, bodies,
         tagged_facets(body, scene, "pair striker", pair.striker),
         tagged_facets(body, scene, "pair target", pair.target),
         ContactSettings(r=pair.r, relative=pair.relative),
-        prescribed=prescribed, tractions=tractions,
     )
+    if pair.mu is not None:
+        from fenics_contact.model.pair_friction import FrictionalTwoBodyProblem
+
+        return FrictionalTwoBodyProblem(
+            *args, mu=pair.mu, tangential_r_max=pair.tangential_r_max,
+            prescribed=prescribed, tractions=tractions,
+        )
+    return TwoBodyProblem(*args, prescribed=prescribed, tractions=tractions)
 
 
 def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProblem:

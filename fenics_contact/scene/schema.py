@@ -32,6 +32,14 @@ Layout (units are the user's; be consistent)::
                  Schur field split, algebraic multigrid; for large 3D)
     [output]     fields = [...], pictures = true
 
+Two deformable bodies in one mesh replace [material], [obstacle] and
+[contact] by::
+
+    [[body]]     name, tag (cell tag), law, E, nu      (one per body)
+    [[pair]]     striker, target (facet tags), r, relative,
+                 mu, tangential_r_max (Coulomb friction, as in [contact])
+    [[dirichlet]] may give path = [[t, ux, uy], ...] instead of value
+
 Generated meshes tag their sides: rectangle left = 1, right = 2,
 bottom = 3, top = 4; box xmin = 1, xmax = 2, ymin = 3, ymax = 4, zmin = 5,
 zmax = 6. Tags may be given by number or by name.
@@ -67,7 +75,7 @@ _SCHEMA: dict[str, set[str]] = {
     "": {"scene", "mesh", "material", "dirichlet", "traction", "obstacle", "contact", "solver",
          "output", "body", "pair"},
     "body": {"name", "tag", "law", "E", "nu"},
-    "pair": {"name", "striker", "target", "r", "relative"},
+    "pair": {"name", "striker", "target", "r", "relative", "mu", "tangential_r_max"},
     "scene": {"name", "dimension", "description"},
     "mesh": {"file", "generator", "origin", "size", "cells", "cell", "parameters"},
     "material": {"law", "E", "nu", "kinematics"},
@@ -133,6 +141,8 @@ class PairSpec:
     target: int | str
     r: float = 1.0
     relative: bool = True
+    mu: float | None = None
+    tangential_r_max: float | None = 0.1
 
 
 @dataclass(frozen=True)
@@ -463,6 +473,8 @@ def _pairs(path: Path, data: dict[str, Any]) -> tuple[PairSpec, ...]:
             name=str(reader.table.get("name", f"pair{len(out) + 1}")),
             striker=reader.tag("striker"), target=reader.tag("target"),
             r=_contact_r(reader), relative=reader.flag("relative", True),
+            mu=_friction(reader),
+            tangential_r_max=reader.number("tangential_r_max", 0.1, positive=True),
         ))
     if len(out) > 1:
         raise SceneError(f"{path.name}: {len(out)} [[pair]] blocks; one contact pair per scene "
@@ -610,7 +622,6 @@ def load_scene(path: Path | str) -> Scene:
         )
     E, nu = _elastic_constants(material)
     output = _table(path, data, "output", required=False)
-    fields = output.table.get("fields")
     mesh_spec = _mesh(path, _table(path, data, "mesh"), dimension)
     dirichlet = tuple(_boundary(r, dimension, True) for r in _array(path, data, "dirichlet"))
     tractions = tuple(_boundary(r, dimension, False) for r in _array(path, data, "traction"))
@@ -621,11 +632,7 @@ def load_scene(path: Path | str) -> Scene:
             f"{path.name}: [contact] detect = true follows the obstacle's straight motion; "
             "with [obstacle] schedule give the candidate facets by [contact] tag."
         )
-    allowed = FIELDS + FRICTION_FIELDS if contact.mu is not None else FIELDS
-    fields = list(allowed) if fields is None else fields
-    if not isinstance(fields, list) or any(f not in allowed for f in fields):
-        hint = "" if contact.mu is not None else " (friction fields need [contact] mu)"
-        raise output.fail("fields", f"choose from {', '.join(allowed)}{hint}.")
+    fields = _fields(output, contact.mu, "[contact]")
     return Scene(
         path=path,
         name=str(head.table.get("name", path.stem)),
@@ -643,6 +650,17 @@ def load_scene(path: Path | str) -> Scene:
         fields=tuple(fields),
         pictures=output.flag("pictures", True),
     )
+
+
+def _fields(output: _Reader, mu: float | None, section: str) -> tuple[str, ...]:
+    """The output fields: all by default; friction fields only with a coefficient mu."""
+    allowed = FIELDS + FRICTION_FIELDS if mu is not None else FIELDS
+    fields = output.table.get("fields")
+    fields = list(allowed) if fields is None else fields
+    if not isinstance(fields, list) or any(f not in allowed for f in fields):
+        hint = "" if mu is not None else f" (friction fields need {section} mu)"
+        raise output.fail("fields", f"choose from {', '.join(allowed)}{hint}.")
+    return tuple(fields)
 
 
 def _elastic_constants(material: _Reader) -> tuple[float, float]:
@@ -670,11 +688,9 @@ def _two_body_scene(path: Path, data: dict[str, Any], head: _Reader, dimension: 
     if not pairs:
         raise SceneError(f"{path.name}: no [[pair]] block; add one with striker and target "
                          "facet tags.")
-    output = _table(path, data, "output", required=False)
-    fields = output.table.get("fields", list(FIELDS))
-    if not isinstance(fields, list) or any(f not in FIELDS for f in fields):
-        raise output.fail("fields", f"choose from {', '.join(FIELDS)}.")
     pair = pairs[0]
+    output = _table(path, data, "output", required=False)
+    fields = _fields(output, pair.mu, "[[pair]]")
     return Scene(
         path=path,
         name=str(head.table.get("name", path.stem)),
@@ -687,7 +703,8 @@ def _two_body_scene(path: Path, data: dict[str, Any], head: _Reader, dimension: 
         dirichlet=tuple(_boundary(r, dimension, True) for r in _array(path, data, "dirichlet")),
         tractions=tuple(_boundary(r, dimension, False) for r in _array(path, data, "traction")),
         obstacle=ObstacleSpec("none"),
-        contact=ContactSpec(tag=pair.striker, r=pair.r, relative=pair.relative),
+        contact=ContactSpec(tag=pair.striker, r=pair.r, relative=pair.relative, mu=pair.mu,
+                            tangential_r_max=pair.tangential_r_max),
         solver=_solver(_table(path, data, "solver", required=False)),
         fields=tuple(fields),
         pictures=output.flag("pictures", True),
