@@ -1,6 +1,10 @@
-"""Coulomb friction with the Alart-Curnier augmented Lagrangian, against rigid obstacles.
+"""Coulomb friction with the Alart-Curnier augmented Lagrangian.
 
 Quasi-static and incremental (Alart and Curnier 1991, the paper's reference [4]).
+:class:`FrictionMixin` holds what every frictional problem shares; this module
+applies it to rigid obstacles (:class:`FrictionalContactProblem`) and
+:mod:`.pair_friction` to two deformable bodies. The formulas below are the
+rigid ones; the deformable target only changes the slip and the frame.
 
 Signs. The normal part is the frictionless one: the augmented pressure
 p_n = min(lam_n + r g, 0) <= 0 and the body receives the traction -p_n n
@@ -57,12 +61,13 @@ from dolfinx import default_scalar_type, fem
 
 from mpi4py import MPI
 
-from fenics_contact.model.contact import assemble_local, penalty_energy
+from fenics_contact.model.contact import ContactSurface, assemble_local
 from fenics_contact.model.problem import (
     ContactProblem,
     ContactState,
     ProblemState,
     VariationalSystem,
+    Work,
 )
 
 #: Guard of the tangential norm relative to E (stress units: eps = GUARD * E).
@@ -133,33 +138,47 @@ class FrictionalContactState(ContactState):
     slip_count: int = 0
 
 
-class FrictionalContactProblem(ContactProblem):
-    """A body against a rigid obstacle with Coulomb friction of coefficient ``mu``.
+def check_friction(mu: float, tangential_r_max: float | None) -> None:
+    """Raise ValueError naming a bad friction coefficient or tangential cap."""
+    if not (np.isfinite(mu) and mu >= 0):
+        raise ValueError(
+            f"The friction coefficient mu must be finite and >= 0, got mu = {mu}; "
+            "use 0 for frictionless contact, typical values are 0.1 to 1."
+        )
+    if tangential_r_max is not None and not (
+        np.isfinite(tangential_r_max) and tangential_r_max > 0
+    ):
+        raise ValueError(
+            f"tangential_r_max must be finite and > 0 (relative to E/h), got "
+            f"{tangential_r_max}; None makes r_t = r."
+        )
 
-    Adds the tangential multiplier ``lam_t`` (P1 on the contact submesh,
-    d-1 components), the last converged displacement ``u_prev`` and obstacle
-    placement ``c_prev``; :meth:`commit` moves them forward after each
-    converged increment. ``tangential_r_max`` caps the tangential parameter
-    r_t = min(r, tangential_r_max E/h) (None: r_t = r). Other arguments as
-    :class:`ContactProblem`.
+
+class FrictionMixin:
+    """Coulomb friction on top of a contact problem (rigid obstacle or deformable pair).
+
+    The host problem provides u, lam, r, the gap, the augmented pressure, the
+    contact surface and the systems builder ``_system``; the subclass says
+    how the slip increment and the tangent frame are measured
+    (:meth:`_slip_increment`) and what else moves forward at :meth:`commit`
+    (:meth:`_commit_frame`). This class holds the tangential multiplier
+    lam_t, the last converged displacement u_prev, the projected traction,
+    the frictional systems and the nodal diagnostics.
     """
 
-    def __init__(
-        self, *args, mu: float, tangential_r_max: float | None = 0.1, **kwargs
-    ) -> None:
-        if not (np.isfinite(mu) and mu >= 0):
-            raise ValueError(
-                f"The friction coefficient mu must be finite and >= 0, got mu = {mu}; "
-                "use 0 for frictionless contact, typical values are 0.1 to 1."
-            )
-        if tangential_r_max is not None and not (
-            np.isfinite(tangential_r_max) and tangential_r_max > 0
-        ):
-            raise ValueError(
-                f"tangential_r_max must be finite and > 0 (relative to E/h), got "
-                f"{tangential_r_max}; None makes r_t = r."
-            )
-        super().__init__(*args, **kwargs)
+    domain: object
+    comm: MPI.Comm
+    surface: ContactSurface
+    u: fem.Function
+    lam: fem.Function
+    Q: fem.FunctionSpace
+    V: fem.FunctionSpace
+    r: fem.Constant
+    pressure: ufl.core.expr.Expr
+    gap: ufl.core.expr.Expr
+
+    def _init_friction(self, mu: float, tangential_r_max: float | None) -> None:
+        """Create lam_t, u_prev, the slip, the projected traction and the nodal forms."""
         domain = self.domain
         gdim = domain.geometry.dim
         self.gdim = gdim
@@ -174,15 +193,7 @@ class FrictionalContactProblem(ContactProblem):
             self.lam_t = fem.Function(self.Qt, name="tangential_multiplier")
             lam_t = self.lam_t
         self.u_prev = fem.Function(self.V, name="displacement_prev")
-        self.c_prev = fem.Constant(domain, np.array(self.obstacle.point.value, dtype=float))
-
-        X = ufl.SpatialCoordinate(domain)
-        x = X + self.u
-        x_prev = X + self.u_prev
-        n = self.obstacle.normal_at(x)
-        self.tangents = tangent_basis(n, gdim)
-        motion = self.obstacle.point - self.c_prev
-        self.slip = self.tangents.T * ((x - x_prev) - motion)
+        self.tangents, self.slip = self._slip_increment()
         #: Tangential parameter r_t = min(r, tangential_r_max E/h) (stress/length);
         #: follows r when a strategy changes it.
         self.r_t: ufl.core.expr.Expr = self.r
@@ -201,20 +212,28 @@ class FrictionalContactProblem(ContactProblem):
         self._penalty_commit = False
 
         k = gdim - 1
-        self._tau_forms = [self.surface.nodal_form(self.traction_t[i]) for i in range(k)]
-        self._pen_forms = [self.surface.nodal_form(self.penalty_traction[i]) for i in range(k)]
-        self._slip_forms = [self.surface.nodal_form(self.slip[i]) for i in range(k)]
-        self._y_forms = [self.surface.nodal_form(self.trial_traction[i]) for i in range(k)]
-        self._rho_form = self.surface.nodal_form(self.coulomb_radius)
+        nodal = self.surface.nodal_form
+        self._tau_forms = [nodal(self.traction_t[i]) for i in range(k)]
+        self._pen_forms = [nodal(self.penalty_traction[i]) for i in range(k)]
+        self._slip_forms = [nodal(self.slip[i]) for i in range(k)]
+        self._y_forms = [nodal(self.trial_traction[i]) for i in range(k)]
+        self._rho_form = nodal(self.coulomb_radius)
         self._global_forms = [
-            [self.surface.nodal_form(-(self.tangents * self.traction_t)[i]) for i in range(gdim)],
-            [self.surface.nodal_form((self.tangents * self.slip)[i]) for i in range(gdim)],
+            [nodal(-(self.tangents * self.traction_t)[i]) for i in range(gdim)],
+            [nodal((self.tangents * self.slip)[i]) for i in range(gdim)],
         ]
         force = self.tangents * self.traction_t
         self._tforce_forms = [
             fem.form(force[i] * self.surface.ds, entity_maps=self.surface.entity_maps)
             for i in range(gdim)
         ]
+
+    def _slip_increment(self) -> tuple[ufl.core.expr.Expr, ufl.core.expr.Expr]:
+        """(T, dg_t): the gdim x (d-1) tangent matrix and the slip increment (length)."""
+        raise NotImplementedError
+
+    def _commit_frame(self) -> None:
+        """Move the reference of the slip forward with u_prev (obstacle, target)."""
 
     # -- state ----------------------------------------------------------------------
     @property
@@ -223,7 +242,7 @@ class FrictionalContactProblem(ContactProblem):
         return float(self.mu.value)
 
     def commit(self) -> None:
-        """Accept the converged increment: u_prev <- u, c_prev <- c.
+        """Accept the converged increment: u_prev <- u and the reference of the slip.
 
         After a penalty solve the committed tangential traction is kept in
         lam_t (the regularised-stick history); AL methods already hold it there.
@@ -231,7 +250,7 @@ class FrictionalContactProblem(ContactProblem):
         if self._penalty_commit:
             self._set_lam_t(self._nodal_components(self._pen_forms))
         self.u_prev.x.array[:] = self.u.x.array
-        self.c_prev.value[:] = self.obstacle.point.value
+        self._commit_frame()
 
     def snapshot(self) -> FrictionalProblemState:
         """Copy u, lam_n, lam_t and the load factor."""
@@ -242,16 +261,28 @@ class FrictionalContactProblem(ContactProblem):
 
     def restore(self, state: ProblemState, *, load: bool = True) -> None:
         """Put back a :meth:`snapshot` (lam_t too when the snapshot holds it)."""
-        super().restore(state, load=load)
+        super().restore(state, load=load)  # type: ignore[misc]
         if isinstance(state, FrictionalProblemState) and state.lam_t.size:
             self.lam_t.x.array[:] = state.lam_t
 
     # -- systems -----------------------------------------------------------------------
-    def _tangential_work(self, traction: ufl.core.expr.Expr) -> ufl.Form:
-        """Int traction . d(dg_t)[v] ds: the friction force on the body, -T traction."""
-        v = ufl.TestFunction(self.V)
-        virtual_slip = ufl.derivative(self.slip, self.u, v)
-        return ufl.dot(traction, virtual_slip) * self.surface.ds
+    def _friction_work(self, traction: ufl.core.expr.Expr) -> Work:
+        """(c, test) -> int traction . d(dg_t)/dc[test] ds, for u and every extra c.
+
+        The body (and, for a deformable target, the target's vertices through
+        the derivative with respect to w_k) receives the friction force.
+        """
+
+        def work(c: fem.Function, test: ufl.Argument) -> ufl.Form:
+            return ufl.dot(traction, ufl.derivative(self.slip, c, test)) * self.surface.ds
+
+        return work
+
+    def _tangential_residual(self) -> ufl.Form:
+        """(P(lam_t + r_t dg_t) - lam_t) . mu_t ds (force units)."""
+        mu_t = ufl.TestFunction(self.Qt)
+        mu_t = ufl.as_vector([mu_t]) if self.gdim == 2 else mu_t
+        return ufl.dot(self.traction_t - self._lam_t_vector, mu_t) * self.surface.ds
 
     def augmented_system(self) -> VariationalSystem:
         """Newton on (u, lam_n, lam_t): the frictional GNRM system.
@@ -259,22 +290,18 @@ class FrictionalContactProblem(ContactProblem):
         Multiplier blocks: (min(lam_n + r g, 0) - lam_n) mu_n and
         (P(lam_t + r_t dg_t) - lam_t) . mu_t, both in force units.
         """
-        base = super().augmented_system()
-        residual_u = base.residuals[0] + self._tangential_work(self.traction_t)
-        mu_t = ufl.TestFunction(self.Qt)
-        mu_t = ufl.as_vector([mu_t]) if self.gdim == 2 else mu_t
-        residual_t = ufl.dot(self.traction_t - self._lam_t_vector, mu_t) * self.surface.ds
-        return VariationalSystem(
-            "augmented_friction", [residual_u, base.residuals[1], residual_t],
-            [self.u, self.lam, self.lam_t], self.bcs, self.surface.entity_maps,
+        return self._system(  # type: ignore[attr-defined]
+            "augmented_friction", self._lagrangian(), with_lam=True,  # type: ignore[attr-defined]
+            work=self._friction_work(self.traction_t),
+            multipliers=[(self.lam_t, self._tangential_residual())],
         )
 
     def primal_system(self) -> VariationalSystem:
         """Equilibrium in u with lam_n and lam_t held fixed (Uzawa inner problem)."""
-        base = super().primal_system()
-        base.residuals[0] = base.residuals[0] + self._tangential_work(self.traction_t)
-        base.name = "primal_friction"
-        return base
+        return self._system(  # type: ignore[attr-defined]
+            "primal_friction", self._lagrangian(), with_lam=False,  # type: ignore[attr-defined]
+            work=self._friction_work(self.traction_t),
+        )
 
     def penalty_system(self) -> VariationalSystem:
         """Penalty in u: normal r/2 min(g, 0)^2, tangential tau = P(lam_t + r_t dg_t).
@@ -282,26 +309,20 @@ class FrictionalContactProblem(ContactProblem):
         The disc radius is mu r max(-g, 0); lam_t holds the traction committed
         at the last converged step (regularised stick, updated by :meth:`commit`).
         """
-        v = ufl.TestFunction(self.V)
-        energy = self.potential + penalty_energy(self.gap, self.r) * self.surface.ds
-        residual = ufl.derivative(energy, self.u, v) + self._tangential_work(
-            self.penalty_traction
-        )
         self._penalty_commit = True
-        return VariationalSystem(
-            "penalty_friction", [residual], [self.u], self.bcs, self.surface.entity_maps
+        return self._system(  # type: ignore[attr-defined]
+            "penalty_friction", self._penalty_energy(),  # type: ignore[attr-defined]
+            with_lam=False, work=self._friction_work(self.penalty_traction),
         )
 
     def complementarity_residual(self) -> list[ufl.Form]:  # type: ignore[override]
         """Normal and tangential complementarity residuals (force units)."""
-        mu_t = ufl.TestFunction(self.Qt)
-        mu_t = ufl.as_vector([mu_t]) if self.gdim == 2 else mu_t
-        tangential = ufl.dot(self.traction_t - self._lam_t_vector, mu_t) * self.surface.ds
-        return [super().complementarity_residual(), tangential]
+        return [super().complementarity_residual(), self._tangential_residual()]  # type: ignore[misc]
 
     # -- nodal values and diagnostics ------------------------------------------------------
     def _nodal_components(self, forms: Sequence[fem.Form]) -> np.ndarray:
         """Owned nodal values of a (d-1)-vector expression, shape (n, d-1)."""
+        self.refresh_search()  # type: ignore[attr-defined]
         return np.column_stack([self.surface.nodal(f) for f in forms])
 
     def _set_lam_t(self, values: np.ndarray) -> None:
@@ -316,17 +337,17 @@ class FrictionalContactProblem(ContactProblem):
         lam_n <- min(lam_n + r g, 0) and lam_t <- P(lam_t + r_t dg_t).
         """
         tau = self._nodal_components(self._tau_forms)
-        super().update_multiplier()
+        super().update_multiplier()  # type: ignore[misc]
         self._set_lam_t(tau)
 
     def node_states(self) -> np.ndarray:
         """Per owned node: 0 open (p_n = 0), 1 stick (|y| < rho), 2 slip."""
-        rho = self.surface.nodal(self._rho_form)
         y = self._nodal_components(self._y_forms)
+        rho = self.surface.nodal(self._rho_form)
         eps = float(self.eps.value)
         norm = np.sqrt(np.sum(y**2, axis=1) + eps**2)
         state = np.full(rho.size, OPEN, dtype=np.int8)
-        active = self.surface.nodal(self._pressure_form) < 0.0
+        active = self.surface.nodal(self._pressure_form) < 0.0  # type: ignore[attr-defined]
         state[active] = np.where(norm[active] < rho[active], STICK, SLIP)
         return state
 
@@ -338,23 +359,21 @@ class FrictionalContactProblem(ContactProblem):
         """Owned nodal vectors in global axes, shape (n, gdim) each.
 
         The tangential traction on the body -T tau (stress) and the slip
-        increment T dg_t of the body relative to the obstacle (length).
+        increment T dg_t of the body relative to the obstacle or target (length).
         """
-        traction, slip = (
-            np.column_stack([self.surface.nodal(f) for f in forms])
-            for forms in self._global_forms
-        )
+        traction, slip = (self._nodal_components(forms) for forms in self._global_forms)
         return traction, slip
 
     def tangential_force_vector(self) -> np.ndarray:
         """Global int T tau dA (force; per thickness in 2D): minus the friction on the body."""
+        self.refresh_search()  # type: ignore[attr-defined]
         return np.array([
             self.comm.allreduce(fem.assemble_scalar(f), op=MPI.SUM) for f in self._tforce_forms
         ])
 
     def contact_state(self) -> FrictionalContactState:
         """Normal diagnostics plus tangential traction, slip, Coulomb limit and node states."""
-        base = super().contact_state()
+        base = super().contact_state()  # type: ignore[misc]
         states = self.node_states()
         comm = self.comm
         return FrictionalContactState(
@@ -370,8 +389,42 @@ class FrictionalContactProblem(ContactProblem):
 
     def complementarity_norms(self) -> tuple[float, float]:
         """Euclidean norms of the normal and tangential complementarity residuals (force)."""
+        self.refresh_search()  # type: ignore[attr-defined]
         out = []
         for form in self.complementarity_residual():
             local = assemble_local(fem.form(form, entity_maps=self.surface.entity_maps))
             out.append(float(np.sqrt(self.comm.allreduce(float(local @ local), op=MPI.SUM))))
         return out[0], out[1]
+
+
+class FrictionalContactProblem(FrictionMixin, ContactProblem):
+    """A body against a rigid obstacle with Coulomb friction of coefficient ``mu``.
+
+    Adds the tangential multiplier ``lam_t`` (P1 on the contact submesh,
+    d-1 components), the last converged displacement ``u_prev`` and obstacle
+    placement ``c_prev``; :meth:`commit` moves them forward after each
+    converged increment. ``tangential_r_max`` caps the tangential parameter
+    r_t = min(r, tangential_r_max E/h) (None: r_t = r). Other arguments as
+    :class:`ContactProblem`.
+    """
+
+    def __init__(
+        self, *args, mu: float, tangential_r_max: float | None = 0.1, **kwargs
+    ) -> None:
+        check_friction(mu, tangential_r_max)
+        super().__init__(*args, **kwargs)
+        self._init_friction(mu, tangential_r_max)
+
+    def _slip_increment(self) -> tuple[ufl.core.expr.Expr, ufl.core.expr.Expr]:
+        """T from the obstacle normal; dg_t = T^T [(x - x_prev) - (c - c_prev)]."""
+        self.c_prev = fem.Constant(self.domain, np.array(self.obstacle.point.value, dtype=float))
+        X = ufl.SpatialCoordinate(self.domain)
+        x = X + self.u
+        x_prev = X + self.u_prev
+        tangents = tangent_basis(self.obstacle.normal_at(x), self.gdim)
+        motion = self.obstacle.point - self.c_prev
+        return tangents, tangents.T * ((x - x_prev) - motion)
+
+    def _commit_frame(self) -> None:
+        """c_prev <- c."""
+        self.c_prev.value[:] = self.obstacle.point.value

@@ -37,7 +37,6 @@ from fenics_contact.model.contact import (
     ContactSurface,
     augmented_lagrangian_energy,
     augmented_pressure,
-    penalty_energy,
 )
 from fenics_contact.model.materials import Elastic
 from fenics_contact.model.problem import (
@@ -45,7 +44,6 @@ from fenics_contact.model.problem import (
     ContactState,
     PrescribedDisplacement,
     SurfaceTraction,
-    VariationalSystem,
     _facet_tags,
     energy_quadrature_degree,
 )
@@ -181,6 +179,7 @@ class DeformablePair:
         self.w = [fem.Function(self.W, name=f"target_w{k}") for k in range(nv)]
         self.assignment = np.full(n_w, -1, np.int64)
         self.projection = None
+        self.w_prev: list[fem.Function] | None = None
         #: Incremented whenever some striker node changes facet (on any rank).
         self.version = 0
         self.search_count = 0
@@ -193,22 +192,72 @@ class DeformablePair:
         return np.cross(X[:, 1] - X[:, 0], X[:, 2] - X[:, 0])
 
     # -- UFL -------------------------------------------------------------------
-    def gap(self, x_s: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
-        """Signed normal gap of the striker point ``x_s`` to its facet's plane (length)."""
-        xk = [Xk + wk for Xk, wk in zip(self.X, self.w, strict=True)]
+    def positions(self) -> list[ufl.core.expr.Expr]:
+        """Current positions x_k = X_k + w_k of the assigned facet's vertices."""
+        return [Xk + wk for Xk, wk in zip(self.X, self.w, strict=True)]
+
+    def normal(self) -> ufl.core.expr.Expr:
+        """Unit outward normal of the assigned target facet (current configuration)."""
+        xk = self.positions()
         if self.gdim == 2:
             t = xk[1] - xk[0]
-            n = ufl.as_vector((t[1], -t[0])) / ufl.sqrt(ufl.dot(t, t))
-        else:
-            c = ufl.cross(xk[1] - xk[0], xk[2] - xk[0])
-            n = c / ufl.sqrt(ufl.dot(c, c))
-        return ufl.dot(x_s - xk[0], n)
+            return ufl.as_vector((t[1], -t[0])) / ufl.sqrt(ufl.dot(t, t))
+        c = ufl.cross(xk[1] - xk[0], xk[2] - xk[0])
+        return c / ufl.sqrt(ufl.dot(c, c))
+
+    def gap(self, x_s: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+        """Signed normal gap of the striker point ``x_s`` to its facet's plane (length)."""
+        return ufl.dot(x_s - self.positions()[0], self.normal())
+
+    def shape_weights(self, x_s: ufl.core.expr.Expr) -> list[ufl.core.expr.Expr]:
+        """Weights N_k of the facet vertices at the projection of ``x_s`` (sum 1).
+
+        2D: xi = (x_s - x_a) . t / |t|^2, N = (1 - xi, xi). 3D: the
+        barycentric coordinates (1 - s - t, s, t) of the projection on the
+        triangle's plane. Unclamped, like the gap.
+        """
+        xk = self.positions()
+        d = x_s - xk[0]
+        if self.gdim == 2:
+            t = xk[1] - xk[0]
+            xi = ufl.dot(d, t) / ufl.dot(t, t)
+            return [1.0 - xi, xi]
+        e1, e2 = xk[1] - xk[0], xk[2] - xk[0]
+        g11, g12, g22 = ufl.dot(e1, e1), ufl.dot(e1, e2), ufl.dot(e2, e2)
+        r1, r2 = ufl.dot(d, e1), ufl.dot(d, e2)
+        det = g11 * g22 - g12**2
+        s = (g22 * r1 - g12 * r2) / det
+        t = (g11 * r2 - g12 * r1) / det
+        return [1.0 - s - t, s, t]
+
+    def track_previous(self, u_prev: fem.Function) -> list[fem.Function]:
+        """Hold the assigned vertices' displacements in ``u_prev`` as data on W.
+
+        Returns the coefficients w_prev_k (filled at every search and by
+        :meth:`set_previous`); they are data, not unknowns.
+        """
+        self._u_prev = u_prev
+        self.w_prev = [fem.Function(self.W, name=f"target_w{k}_prev") for k in range(self.gdim)]
+        self.set_previous()
+        return self.w_prev
+
+    def set_previous(self) -> None:
+        """Gather the target's displacements in u_prev and refill w_prev_k (collective)."""
+        self._prev_t = self.target_displacements(self._u_prev)
+        self._fill_previous()
+
+    def _fill_previous(self) -> None:
+        if self.w_prev is None or self.assignment.size == 0 or np.any(self.assignment < 0):
+            return
+        verts = self.facet_vertex[self.assignment]
+        for k, wk in enumerate(self.w_prev):
+            wk.x.array[:] = self._prev_t[verts[:, k]].reshape(-1)
 
     # -- search ------------------------------------------------------------------
-    def target_displacements(self) -> np.ndarray:
-        """Current displacement of every target vertex, gathered on every rank."""
+    def target_displacements(self, u: fem.Function | None = None) -> np.ndarray:
+        """Displacement (default: the current u) of every target vertex, on every rank."""
         bs = self.gdim
-        values = self.u.x.array.reshape(-1, bs)[self._own_local]
+        values = (self.u if u is None else u).x.array.reshape(-1, bs)[self._own_local]
         gathered = np.concatenate(self.comm.allgather(values.reshape(-1, bs)))
         out = np.empty((self.vertices.size, bs))
         out[self._own_pos] = gathered
@@ -241,6 +290,7 @@ class DeformablePair:
         for k in range(self.gdim):
             self.X[k].x.array[:] = self.X_vertices[verts[:, k]].reshape(-1)
             self.w[k].x.array[:] = w_t[verts[:, k]].reshape(-1)
+        self._fill_previous()
         if changed:
             self.version += 1
         return changed
@@ -438,6 +488,11 @@ class TwoBodyProblem(ContactProblem):
             out[i] = vec.array[dofs].sum()
         return self.comm.allreduce(out, op=MPI.SUM)
 
+    def _contact_residual(self, wk: fem.Function, q: ufl.Argument) -> ufl.Form:
+        """dL_c/dw_k[q] of the contact term (the force on the k-th facet vertex, negated)."""
+        term = augmented_lagrangian_energy(self.gap, self.lam, self.r) * self.surface.ds
+        return ufl.derivative(term, wk, q)
+
     def target_force(self) -> fem.Function:
         """Contact force the striker puts on the target's vertices (force per node).
 
@@ -446,10 +501,9 @@ class TwoBodyProblem(ContactProblem):
         force on its facet's vertices in 2D. Zero off the target surface.
         """
         if self._target_force_forms is None:
-            term = augmented_lagrangian_energy(self.gap, self.lam, self.r) * self.surface.ds
             q = ufl.TestFunction(self.pair.W)
             self._target_force_forms = [
-                fem.form(ufl.derivative(term, wk, q), entity_maps=self.surface.entity_maps)
+                fem.form(self._contact_residual(wk, q), entity_maps=self.surface.entity_maps)
                 for wk in self.pair.w
             ]
         self.pair.refresh()
@@ -484,39 +538,15 @@ class TwoBodyProblem(ContactProblem):
         return f
 
     # -- systems -----------------------------------------------------------------
-    def _extended(self, name: str, energy: ufl.Form, with_lam: bool) -> VariationalSystem:
-        v = ufl.TestFunction(self.V)
-        residuals = [ufl.derivative(energy, self.u, v)]
-        unknowns = [self.u]
-        if with_lam:
-            mu = ufl.TestFunction(self.Q)
-            residuals.append(self.r * ufl.derivative(energy, self.lam, mu))
-            unknowns.append(self.lam)
-        for wk in self.pair.w:
-            residuals.append(ufl.derivative(energy, wk, ufl.TestFunction(self.pair.W)))
-        return VariationalSystem(
-            name, residuals, unknowns, self.bcs, self.surface.entity_maps,
-            extras=list(self.pair.w), transfer=self.pair,
-        )
-
-    def augmented_system(self) -> VariationalSystem:
-        """Alart-Curnier on (u, lam), extended by the target vertex displacements."""
-        lagrangian = self.potential + augmented_lagrangian_energy(
-            self.gap, self.lam, self.r) * self.surface.ds
-        return self._extended("augmented", lagrangian, with_lam=True)
-
-    def primal_system(self) -> VariationalSystem:
-        """Equilibrium in u with lam fixed (Uzawa inner problem), extended."""
-        lagrangian = self.potential + augmented_lagrangian_energy(
-            self.gap, self.lam, self.r) * self.surface.ds
-        return self._extended("primal", lagrangian, with_lam=False)
-
-    def penalty_system(self) -> VariationalSystem:
-        """Penalty (paper eq. 7) in u only, extended."""
-        energy = self.potential + penalty_energy(self.gap, self.r) * self.surface.ds
-        return self._extended("penalty", energy, with_lam=False)
+    def _extra_unknowns(self) -> list[fem.Function]:
+        """The target vertex displacements w_k (condensed by w_k = S_k u)."""
+        return list(self.pair.w)
 
     # -- diagnostics (search first: u may have moved since the last assembly) -----
+    def refresh_search(self) -> None:
+        """Search and refill the target coefficients when u has changed."""
+        self.pair.refresh()
+
     def contact_state(self) -> ContactState:
         """Nodal gaps, pressures and global summaries at the current u (fresh search)."""
         self.pair.refresh()

@@ -9,7 +9,7 @@ All loads are proportional to one load factor ``t`` in [0, 1].
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -90,6 +90,9 @@ def energy_quadrature_degree(psi: ufl.core.expr.Expr, u: fem.Function, degree: i
     estimate = ufl.algorithms.estimate_total_polynomial_degree(integrand)
     return int(min(estimate, 2 * (degree + 1)))
 
+
+#: A non-potential residual term: (coefficient, test function) -> form (or None).
+Work = Callable[[fem.Function, ufl.Argument], ufl.Form]
 
 #: Facet tag of the first traction; the i-th traction has TRACTION_TAG0 + i.
 TRACTION_TAG0 = 100
@@ -398,6 +401,9 @@ class ContactProblem(ProblemBase):
     def commit(self) -> None:
         """Accept the current state as converged (history-dependent terms; none here)."""
 
+    def refresh_search(self) -> None:
+        """Bring data that follow u up to date (two bodies: the search); none here."""
+
     def _external_work(self, tractions: Sequence[SurfaceTraction]) -> ufl.Form | None:
         if not tractions:
             return None
@@ -414,43 +420,74 @@ class ContactProblem(ProblemBase):
         return work
 
     # -- systems handed to solvers -------------------------------------------
+    def _extra_unknowns(self) -> list[fem.Function]:
+        """Coefficients that are a selection of u (two bodies: target displacements)."""
+        return []
+
+    def _system(
+        self,
+        name: str,
+        energy: ufl.Form,
+        *,
+        with_lam: bool,
+        work: Work | None = None,
+        multipliers: Sequence[tuple[fem.Function, ufl.Form]] = (),
+    ) -> VariationalSystem:
+        """Residual blocks from an energy plus non-potential terms.
+
+        The residual of u (and of each extra coefficient c, see
+        :meth:`_extra_unknowns`) is dE/dc[test] + work(c, test); with
+        ``with_lam`` the multiplier block r dE/dlam[mu] (force units) follows
+        u; ``multipliers`` appends further unknowns with their residuals
+        (e.g. the tangential multiplier), before the extras' blocks.
+        """
+
+        def residual(c: fem.Function) -> ufl.Form:
+            test = ufl.TestFunction(c.function_space)
+            form = ufl.derivative(energy, c, test)
+            extra = None if work is None else work(c, test)
+            return form if extra is None else form + extra
+
+        residuals = [residual(self.u)]
+        unknowns = [self.u]
+        if with_lam:
+            residuals.append(self.r * ufl.derivative(energy, self.lam, ufl.TestFunction(self.Q)))
+            unknowns.append(self.lam)
+        for function, form in multipliers:
+            residuals.append(form)
+            unknowns.append(function)
+        extras = self._extra_unknowns()
+        residuals += [residual(c) for c in extras]
+        return VariationalSystem(
+            name, residuals, unknowns, self.bcs, self.surface.entity_maps,
+            extras=extras, transfer=getattr(self, "pair", None) if extras else None,
+        )
+
+    def _lagrangian(self) -> ufl.Form:
+        """Pi + int AL density ds (paper eq. 9)."""
+        return self.potential + augmented_lagrangian_energy(
+            self.gap, self.lam, self.r
+        ) * self.surface.ds
+
+    def _penalty_energy(self) -> ufl.Form:
+        """Pi + int r/2 min(g, 0)^2 ds (paper eq. 7)."""
+        return self.potential + penalty_energy(self.gap, self.r) * self.surface.ds
+
     def augmented_system(self) -> VariationalSystem:
         """Alart-Curnier saddle point on (u, lam): the GNRM system.
 
         The multiplier block is r dL/dlam = (min(lam + r g, 0) - lam) mu,
         the complementarity residual in force units.
         """
-        v = ufl.TestFunction(self.V)
-        mu = ufl.TestFunction(self.Q)
-        lagrangian = self.potential + augmented_lagrangian_energy(
-            self.gap, self.lam, self.r
-        ) * self.surface.ds
-        residual_u = ufl.derivative(lagrangian, self.u, v)
-        residual_lam = self.r * ufl.derivative(lagrangian, self.lam, mu)
-        return VariationalSystem(
-            "augmented", [residual_u, residual_lam], [self.u, self.lam], self.bcs,
-            self.surface.entity_maps,
-        )
+        return self._system("augmented", self._lagrangian(), with_lam=True)
 
     def primal_system(self) -> VariationalSystem:
         """Equilibrium in u with lam held fixed (the Uzawa inner problem)."""
-        v = ufl.TestFunction(self.V)
-        lagrangian = self.potential + augmented_lagrangian_energy(
-            self.gap, self.lam, self.r
-        ) * self.surface.ds
-        return VariationalSystem(
-            "primal", [ufl.derivative(lagrangian, self.u, v)], [self.u], self.bcs,
-            self.surface.entity_maps,
-        )
+        return self._system("primal", self._lagrangian(), with_lam=False)
 
     def penalty_system(self) -> VariationalSystem:
         """Penalty regularisation (paper eq. 7) in u only."""
-        v = ufl.TestFunction(self.V)
-        energy = self.potential + penalty_energy(self.gap, self.r) * self.surface.ds
-        return VariationalSystem(
-            "penalty", [ufl.derivative(energy, self.u, v)], [self.u], self.bcs,
-            self.surface.entity_maps,
-        )
+        return self._system("penalty", self._penalty_energy(), with_lam=False)
 
     def complementarity_residual(self) -> ufl.Form:
         """(min(lam + r g, 0) - lam) mu: zero when lam is the converged pressure."""

@@ -107,15 +107,18 @@ def block_on_block(
     n_upper: int = 8,
     n_lower: int = 8,
     *,
+    upper_width: float | None = None,
     rank: int = 0,
 ) -> MeshData:
-    """Two stacked blocks [0, W] x [0, H] (target) and [0, W] x [H, 2H] (striker).
+    """Two stacked blocks [0, W] x [0, H] (target) and [x0, x0 + Wu] x [H, 2H] (striker).
 
-    Structured triangles, ``n_upper`` and ``n_lower`` divisions along x (equal:
-    matching interface). Facets: striker top 2, striker bottom 3, target top
-    4, target bottom 5, both left faces x = 0: 6.
+    Structured triangles, ``n_upper`` and ``n_lower`` divisions along x (equal
+    with equal widths: matching interface). The upper block has width
+    ``upper_width`` (default W), centred: x0 = (W - Wu) / 2. Facets: striker
+    top 2, striker bottom 3, target top 4, target bottom 5, both left faces: 6.
     """
-    _check(width=width, height=height, n_upper=n_upper, n_lower=n_lower)
+    upper = width if upper_width is None else upper_width
+    _check(width=width, height=height, n_upper=n_upper, n_lower=n_lower, upper_width=upper)
 
     def build(gmsh) -> None:
         gmsh.option.setNumber("General.Verbosity", 0)
@@ -123,11 +126,13 @@ def block_on_block(
         gmsh.model.add("block_on_block")
         geo = gmsh.model.geo
         out = {}
-        for name, y0, n in (("lower", 0.0, n_lower), ("upper", height, n_upper)):
-            p = [geo.addPoint(0, y0, 0), geo.addPoint(width, y0, 0),
-                 geo.addPoint(width, y0 + height, 0), geo.addPoint(0, y0 + height, 0)]
+        x0 = 0.5 * (width - upper)
+        for name, y0, n, a, b in (("lower", 0.0, n_lower, 0.0, width),
+                                  ("upper", height, n_upper, x0, x0 + upper)):
+            p = [geo.addPoint(a, y0, 0), geo.addPoint(b, y0, 0),
+                 geo.addPoint(b, y0 + height, 0), geo.addPoint(a, y0 + height, 0)]
             lines = [geo.addLine(p[i], p[(i + 1) % 4]) for i in range(4)]
-            ny = max(2, round(n * height / width))
+            ny = max(2, round(n * height / (b - a)))
             for i, line in enumerate(lines):
                 geo.mesh.setTransfiniteCurve(line, n + 1 if i % 2 == 0 else ny + 1)
             s = geo.addPlaneSurface([geo.addCurveLoop(lines)])
