@@ -221,7 +221,7 @@ def contact_facets(scene: Scene, body: BodyMesh, obstacle: RigidObstacle) -> np.
 
 
 def build_two_body_problem(scene: Scene, body: BodyMesh) -> TwoBodyProblem:
-    """Bodies, conditions and the contact pair of a two-body scene."""
+    """Bodies, conditions and the contact pair of a two-body scene (with [[pair]] mu: friction)."""
     from fenics_contact.model.pairs import Body, PathDisplacement, TwoBodyProblem
 
     comm = body.domain.comm
@@ -256,13 +256,20 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> TwoBodyProblem:
         )
         for i, spec in enumerate(scene.tractions)
     ]
-    return TwoBodyProblem(
+    args = (
         body.domain, body.cell_tags, bodies,
         tagged_facets(body, scene, "pair striker", pair.striker),
         tagged_facets(body, scene, "pair target", pair.target),
         ContactSettings(r=pair.r, relative=pair.relative),
-        prescribed=prescribed, tractions=tractions,
     )
+    if pair.mu is not None:
+        from fenics_contact.model.pair_friction import FrictionalTwoBodyProblem
+
+        return FrictionalTwoBodyProblem(
+            *args, prescribed=prescribed, tractions=tractions, mu=pair.mu,
+            tangential_r_max=pair.tangential_r_max,
+        )
+    return TwoBodyProblem(*args, prescribed=prescribed, tractions=tractions)
 
 
 def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProblem:

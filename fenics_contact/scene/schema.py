@@ -25,6 +25,9 @@ Layout (units are the user's; be consistent)::
                  mu (Coulomb friction coefficient, >= 0; absent: frictionless),
                  tangential_r_max (cap of the tangential parameter r_t =
                  min(r, tangential_r_max E/h); default 0.1)
+    [[body]]     name, tag (cell tag), law, E, nu      } two deformable bodies
+    [[pair]]     striker, target (facet tags), r,     } instead of [material],
+                 relative, mu, tangential_r_max       } [obstacle], [contact]
     [solver]     method, steps, max_iterations, atol, rtol, max_cutbacks,
                  predictor = "extrapolate" (start a step from the linear
                  extrapolation of the last two) | "previous",
@@ -67,7 +70,7 @@ _SCHEMA: dict[str, set[str]] = {
     "": {"scene", "mesh", "material", "dirichlet", "traction", "obstacle", "contact", "solver",
          "output", "body", "pair"},
     "body": {"name", "tag", "law", "E", "nu"},
-    "pair": {"name", "striker", "target", "r", "relative"},
+    "pair": {"name", "striker", "target", "r", "relative", "mu", "tangential_r_max"},
     "scene": {"name", "dimension", "description"},
     "mesh": {"file", "generator", "origin", "size", "cells", "cell", "parameters"},
     "material": {"law", "E", "nu", "kinematics"},
@@ -133,6 +136,8 @@ class PairSpec:
     target: int | str
     r: float = 1.0
     relative: bool = True
+    mu: float | None = None
+    tangential_r_max: float | None = 0.1
 
 
 @dataclass(frozen=True)
@@ -463,6 +468,8 @@ def _pairs(path: Path, data: dict[str, Any]) -> tuple[PairSpec, ...]:
             name=str(reader.table.get("name", f"pair{len(out) + 1}")),
             striker=reader.tag("striker"), target=reader.tag("target"),
             r=_contact_r(reader), relative=reader.flag("relative", True),
+            mu=_friction(reader),
+            tangential_r_max=reader.number("tangential_r_max", 0.1, positive=True),
         ))
     if len(out) > 1:
         raise SceneError(f"{path.name}: {len(out)} [[pair]] blocks; one contact pair per scene "
@@ -610,7 +617,6 @@ def load_scene(path: Path | str) -> Scene:
         )
     E, nu = _elastic_constants(material)
     output = _table(path, data, "output", required=False)
-    fields = output.table.get("fields")
     mesh_spec = _mesh(path, _table(path, data, "mesh"), dimension)
     dirichlet = tuple(_boundary(r, dimension, True) for r in _array(path, data, "dirichlet"))
     tractions = tuple(_boundary(r, dimension, False) for r in _array(path, data, "traction"))
@@ -621,11 +627,7 @@ def load_scene(path: Path | str) -> Scene:
             f"{path.name}: [contact] detect = true follows the obstacle's straight motion; "
             "with [obstacle] schedule give the candidate facets by [contact] tag."
         )
-    allowed = FIELDS + FRICTION_FIELDS if contact.mu is not None else FIELDS
-    fields = list(allowed) if fields is None else fields
-    if not isinstance(fields, list) or any(f not in allowed for f in fields):
-        hint = "" if contact.mu is not None else " (friction fields need [contact] mu)"
-        raise output.fail("fields", f"choose from {', '.join(allowed)}{hint}.")
+    fields = _fields(output, contact.mu, "[contact] mu")
     return Scene(
         path=path,
         name=str(head.table.get("name", path.stem)),
@@ -654,6 +656,16 @@ def _elastic_constants(material: _Reader) -> tuple[float, float]:
     return E, nu
 
 
+def _fields(output: _Reader, mu: float | None, where: str) -> list[str]:
+    """The [output] fields: every allowed one by default; friction fields need mu."""
+    allowed = FIELDS + FRICTION_FIELDS if mu is not None else FIELDS
+    fields = output.table.get("fields", list(allowed))
+    if not isinstance(fields, list) or any(f not in allowed for f in fields):
+        hint = "" if mu is not None else f" (friction fields need {where})"
+        raise output.fail("fields", f"choose from {', '.join(allowed)}{hint}.")
+    return fields
+
+
 def _two_body_scene(path: Path, data: dict[str, Any], head: _Reader, dimension: int) -> Scene:
     """A scene of deformable bodies ([[body]]) and contact pairs ([[pair]])."""
     for key in ("material", "obstacle", "contact"):
@@ -670,11 +682,9 @@ def _two_body_scene(path: Path, data: dict[str, Any], head: _Reader, dimension: 
     if not pairs:
         raise SceneError(f"{path.name}: no [[pair]] block; add one with striker and target "
                          "facet tags.")
-    output = _table(path, data, "output", required=False)
-    fields = output.table.get("fields", list(FIELDS))
-    if not isinstance(fields, list) or any(f not in FIELDS for f in fields):
-        raise output.fail("fields", f"choose from {', '.join(FIELDS)}.")
     pair = pairs[0]
+    output = _table(path, data, "output", required=False)
+    fields = _fields(output, pair.mu, "[[pair]] mu")
     return Scene(
         path=path,
         name=str(head.table.get("name", path.stem)),
@@ -687,7 +697,8 @@ def _two_body_scene(path: Path, data: dict[str, Any], head: _Reader, dimension: 
         dirichlet=tuple(_boundary(r, dimension, True) for r in _array(path, data, "dirichlet")),
         tractions=tuple(_boundary(r, dimension, False) for r in _array(path, data, "traction")),
         obstacle=ObstacleSpec("none"),
-        contact=ContactSpec(tag=pair.striker, r=pair.r, relative=pair.relative),
+        contact=ContactSpec(tag=pair.striker, r=pair.r, relative=pair.relative, mu=pair.mu,
+                            tangential_r_max=pair.tangential_r_max),
         solver=_solver(_table(path, data, "solver", required=False)),
         fields=tuple(fields),
         pictures=output.flag("pictures", True),
