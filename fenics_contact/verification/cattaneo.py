@@ -27,7 +27,8 @@ so it is known to about one contact facet.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -41,10 +42,10 @@ from fenics_contact.model.materials import LinearElastic
 from fenics_contact.model.obstacles import RigidPlane
 from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
 from fenics_contact.scene.meshing import CONTACT_TAG, TOP_TAG, hertz_half_disk
-from fenics_contact.scene.schema import Scene
+from fenics_contact.scene.schema import FIELDS, Scene
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings
-from fenics_contact.solvers.stepping import RunRecord
+from fenics_contact.solvers.stepping import RunRecord, StepRecord
 from fenics_contact.verification.hertz import (
     ContactProfileFit,
     HertzSolution,
@@ -383,50 +384,101 @@ def shear_start(scene: Scene) -> tuple[int, float]:
     )
 
 
-def solve_cattaneo_mindlin(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> CattaneoRun:
-    """Solve a two-body friction scene along its path; measure the stick zone after pressing.
+def _solve_scene(
+    scene: Scene,
+    comm: MPI.Comm,
+    on_step: Callable[[ContactProblem, np.ndarray, StepRecord], None] | None = None,
+    loaded: int | str | None = None,
+) -> tuple[ContactProblem, RunRecord]:
+    """Build a two-body scene and solve its load path with its own solver settings.
 
-    The scene's solver settings (method, tolerances, predictor, steps,
-    cut-backs) are used; nothing is written. Raises RuntimeError when the
-    load path stops before load factor 1.
+    Nothing is written; ``on_step(problem, facets, step)`` after each
+    converged step, ``facets`` those of the facet tag ``loaded``. Raises
+    RuntimeError when the load path stops before load factor 1.
     """
     from fenics_contact.scene.build import build_mesh, build_two_body_problem, tagged_facets
     from fenics_contact.solvers.linear import LinearSolverSettings
     from fenics_contact.solvers.stepping import solve_load_path
 
-    index, t_shear = shear_start(scene)
     body = build_mesh(scene, comm)
     problem = build_two_body_problem(scene, body)
-    loaded = tagged_facets(body, scene, f"dirichlet {index + 1}", scene.dirichlet[index].tag)
+    facets = tagged_facets(body, scene, "loaded", loaded) if loaded is not None else None
     solver = scene.solver
     strategy = make_strategy(
         solver.method, problem,
         SolverSettings(atol=solver.atol, rtol=solver.rtol, max_iterations=solver.max_iterations),
         linear=LinearSolverSettings(kind=solver.linear_solver), predictor=solver.predictor,
     )
-    zones: list[StickZone] = []
-    loads: list[float] = []
-    reactions: list[np.ndarray] = []
-    pressed: list = []
-
-    def measure(step) -> None:
-        if abs(step.load_factor - t_shear) <= 1e-12:
-            pressed.extend([hertz_fit(contact_profile(problem)), step.contact_force])
-        if step.load_factor > t_shear + 1e-12:
-            zones.append(measure_stick_zone(problem))
-            loads.append(step.load_factor)
-            reactions.append(problem.reaction(loaded))
-
     record = solve_load_path(
-        strategy, solver.steps, max_cutbacks=solver.max_cutbacks, on_step=measure
+        strategy, solver.steps, max_cutbacks=solver.max_cutbacks,
+        on_step=None if on_step is None else lambda step: on_step(problem, facets, step),
     )
     if not record.converged:
         raise RuntimeError(
             f"{scene.path.name}: the load path stopped at load factor "
             f"{record.steps[-1].load_factor:g} ({record.status})."
         )
+    return problem, record
+
+
+def solve_cattaneo_mindlin(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> CattaneoRun:
+    """Solve a two-body friction scene along its path; measure the stick zone after pressing.
+
+    The scene's solver settings (method, tolerances, predictor, steps,
+    cut-backs) are used; nothing is written. The reaction is taken on the
+    facets of the [[dirichlet]] block that carries the path.
+    """
+    index, t_shear = shear_start(scene)
+    zones: list[StickZone] = []
+    loads: list[float] = []
+    reactions: list[np.ndarray] = []
+    pressed: list = []
+
+    def measure(problem: ContactProblem, loaded: np.ndarray, step: StepRecord) -> None:
+        if abs(step.load_factor - t_shear) <= 1e-12:
+            pressed.extend([hertz_fit(contact_profile(problem)), step.contact_force])
+        if step.load_factor > t_shear + 1e-12:
+            zones.append(measure_stick_zone(problem))
+            loads.append(step.load_factor)
+            reactions.append(problem.reaction(loaded))  # type: ignore[attr-defined]
+
+    problem, record = _solve_scene(scene, comm, measure, loaded=scene.dirichlet[index].tag)
     return CattaneoRun(problem, record, zones, loads, reactions, contact_profile(problem),
                        *pressed)
+
+
+def pressing_scene(scene: Scene) -> Scene:
+    """The scene up to the end of pressing, frictionless: the path's knots before the shift.
+
+    Load factors are rescaled to 0 ... 1 and the steps cut in proportion,
+    so the last step is the pressed state of the frictional run.
+    """
+    index, t_shear = shear_start(scene)
+    spec = scene.dirichlet[index]
+    knots = tuple((t / t_shear, *rest) for t, *rest in spec.path if t <= t_shear + 1e-12)
+    dirichlet = list(scene.dirichlet)
+    dirichlet[index] = replace(spec, path=knots)
+    pairs = tuple(replace(pair, mu=None) for pair in scene.pairs)
+    return replace(
+        scene, dirichlet=tuple(dirichlet), pairs=pairs,
+        contact=replace(scene.contact, mu=None), fields=FIELDS,
+        solver=replace(scene.solver, steps=max(1, round(scene.solver.steps * t_shear))),
+    )
+
+
+def pressing_check(
+    scene: Scene, R: float = 1.0, comm: MPI.Comm = MPI.COMM_WORLD
+) -> tuple[float, CentredFit, HertzSolution]:
+    """Frictionless pressing of a two-identical-cylinder scene against Hertz.
+
+    Returns the normal contact force P, the fitted ellipse and Hertz for two
+    identical cylinders of radius R with the first body's E and nu at P.
+    """
+    press = pressing_scene(scene)
+    problem, record = _solve_scene(press, comm)
+    P = record.steps[-1].contact_force
+    body = scene.bodies[0]
+    return P, hertz_fit(contact_profile(problem)), two_cylinders_hertz(P, R, body.E, body.nu)
 
 
 def traction_picture(
