@@ -73,7 +73,7 @@ def picture(path: Path, nu: float = 0.45, h: float = 0.002) -> None:
     """Nodal tangential traction and Coulomb limit against Cattaneo-Mindlin (last shear step)."""
     cylinder = CattaneoCylinder(nu=nu, h_contact=h, shift=0.003)
     problem, zones, _ = solve_cattaneo(cylinder)
-    traction_picture(contact_profile(problem), zones[-1], cylinder.mu, path,
+    traction_picture([(contact_profile(problem), zones[-1])], cylinder.mu, path,
                      title=f"cylinder on a rigid plane, nu = {nu}, h = {h}")
 
 

@@ -281,15 +281,18 @@ def stick_zone(profile: ContactProfile, mu: float, P: float, Q: float) -> StickZ
     )
 
 
-def measure_stick_zone(problem: ContactProblem) -> StickZone:
+def measure_stick_zone(
+    problem: ContactProblem, profile: ContactProfile | None = None
+) -> StickZone:
     """Compare the converged state with Cattaneo-Mindlin (collective; every rank gets it).
 
     P and Q are the normal and tangential contact forces of the problem's
-    contact state; mu its friction coefficient.
+    contact state; mu its friction coefficient; ``profile`` the gathered
+    :func:`contact_profile` when already at hand.
     """
     state = problem.contact_state()
     return stick_zone(
-        contact_profile(problem), problem.friction_coefficient,  # type: ignore[attr-defined]
+        profile or contact_profile(problem), problem.friction_coefficient,  # type: ignore[attr-defined]
         state.contact_force, state.tangential_force,  # type: ignore[attr-defined]
     )
 
@@ -351,7 +354,7 @@ class CattaneoRun:
         reactions: force (x, y) the prescribed path exerts on the loaded
             body at each zone (force per thickness): a check of Q and P
             independent of the contact term.
-        profile: the final nodal contact profile.
+        profiles: the nodal contact profile of each zone.
         pressed: Hertz fit at the end of pressing (None if no step ends there).
         pressed_force: normal contact force at the end of pressing.
     """
@@ -361,7 +364,7 @@ class CattaneoRun:
     zones: list[StickZone]
     load_factors: list[float]
     reactions: list[np.ndarray]
-    profile: ContactProfile
+    profiles: list[ContactProfile]
     pressed: CentredFit | None = None
     pressed_force: float = float("nan")
 
@@ -432,19 +435,20 @@ def solve_cattaneo_mindlin(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> Cat
     zones: list[StickZone] = []
     loads: list[float] = []
     reactions: list[np.ndarray] = []
+    profiles: list[ContactProfile] = []
     pressed: list = []
 
     def measure(problem: ContactProblem, loaded: np.ndarray, step: StepRecord) -> None:
         if abs(step.load_factor - t_shear) <= 1e-12:
             pressed.extend([hertz_fit(contact_profile(problem)), step.contact_force])
         if step.load_factor > t_shear + 1e-12:
-            zones.append(measure_stick_zone(problem))
+            profiles.append(contact_profile(problem))
+            zones.append(measure_stick_zone(problem, profiles[-1]))
             loads.append(step.load_factor)
             reactions.append(problem.reaction(loaded))  # type: ignore[attr-defined]
 
     problem, record = _solve_scene(scene, comm, measure, loaded=scene.dirichlet[index].tag)
-    return CattaneoRun(problem, record, zones, loads, reactions, contact_profile(problem),
-                       *pressed)
+    return CattaneoRun(problem, record, zones, loads, reactions, profiles, *pressed)
 
 
 def pressing_scene(scene: Scene) -> Scene:
@@ -482,42 +486,48 @@ def pressing_check(
 
 
 def traction_picture(
-    profile: ContactProfile, zone: StickZone, mu: float, path: Path, title: str = ""
+    panels: list[tuple[ContactProfile, StickZone]], mu: float, path: Path, title: str = ""
 ) -> None:
     """Nodal tangential traction and Coulomb limit against Cattaneo-Mindlin's q(x).
 
-    Abscissa (x - centre)/a; the traction is drawn along Q's direction.
-    Call on one process (the profile is gathered everywhere).
+    One panel per (profile, zone), side by side. Abscissa (x - centre)/a;
+    the traction is drawn along Q's direction. Call on one process (the
+    profiles are gathered everywhere).
     """
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    x = profile.x - zone.centre
-    closed = profile.pressure < 0
-    tau = profile.tau_along_resultant()
-    stick = profile.state == STICK
-    s = np.linspace(-zone.a, zone.a, 401)
-    fig, ax = plt.subplots(figsize=(7, 3.8))
-    ax.plot(s / zone.a, analytic_traction(s, zone.a, zone.c_analytic, zone.p0, mu),
-            "k-", lw=1, label="Cattaneo-Mindlin q(x)")
-    ax.plot(s / zone.a, mu * zone.p0 * np.sqrt(1 - (s / zone.a) ** 2), "k:", lw=0.8,
-            label="mu p (Hertz fit)")
-    ax.plot(x[closed] / zone.a, profile.limit[closed], "+", color="#888888", label="nodal mu p")
-    ax.plot(x[closed & stick] / zone.a, tau[closed & stick], "o", ms=4, label="tau, stick")
-    ax.plot(x[closed & ~stick] / zone.a, tau[closed & ~stick], "x", ms=5, label="tau, slip")
-    for side in (-1, 1):
-        ax.axvline(side * zone.c_analytic / zone.a, color="k", lw=0.5, ls="--")
-    ax.set_xlabel("(x - centre) / a")
-    ax.set_ylabel("tangential traction")
-    ax.set_title(
-        (title + "\n" if title else "")
-        + f"Q/(mu P) = {zone.load_ratio:.3f}: c error {100 * zone.c_error:+.1f} %, "
-        f"traction L2 error {100 * zone.traction_error:.1f} %",
-        fontsize=9,
-    )
-    ax.legend(fontsize=7)
+    fig, axes = plt.subplots(1, len(panels), figsize=(6.2 * len(panels), 3.9), squeeze=False)
+    for ax, (profile, zone) in zip(axes[0], panels, strict=True):
+        x = profile.x - zone.centre
+        closed = profile.pressure < 0
+        tau = profile.tau_along_resultant()
+        stick = profile.state == STICK
+        s = np.linspace(-zone.a, zone.a, 401)
+        ax.plot(s / zone.a, analytic_traction(s, zone.a, zone.c_analytic, zone.p0, mu),
+                "k-", lw=1, label="Cattaneo-Mindlin q(x)")
+        ax.plot(s / zone.a, mu * zone.p0 * np.sqrt(1 - (s / zone.a) ** 2), "k:", lw=0.8,
+                label="mu p (Hertz fit)")
+        ax.plot(x[closed] / zone.a, profile.limit[closed], "+", color="#888888",
+                label="nodal mu p")
+        ax.plot(x[closed & stick] / zone.a, tau[closed & stick], "o", ms=3.5, label="tau, stick")
+        ax.plot(x[closed & ~stick] / zone.a, tau[closed & ~stick], "x", ms=4.5,
+                label="tau, slip")
+        for side in (-1, 1):
+            ax.axvline(side * zone.c_analytic / zone.a, color="k", lw=0.5, ls="--")
+        ax.set_xlabel("(x - centre) / a")
+        ax.set_ylabel("tangential traction")
+        ax.set_title(
+            f"Q/(mu P) = {zone.load_ratio:.2f}: c/a {zone.c_measured / zone.a:.3f} "
+            f"(analytic {zone.c_analytic / zone.a:.3f}), L2 error "
+            f"{100 * zone.traction_error:.1f} %",
+            fontsize=9,
+        )
+        ax.legend(fontsize=7, loc="lower center")
+    if title:
+        fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=120)
