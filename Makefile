@@ -7,7 +7,8 @@ BIN     := $(VENV)/bin
 MPIEXEC ?= $(shell [ -x $(BIN)/mpiexec ] && echo $(BIN)/mpiexec || echo mpiexec)
 OUT     ?= results
 
-.PHONY: demo test test-serial test-mpi soak venv meshes lint clean paper-tables paper-ex1-geometry
+.PHONY: demo test test-serial test-mpi soak venv meshes lint clean paper-tables paper-ex1-geometry \
+        cattaneo-mindlin
 
 venv: $(VENV)/.installed
 
@@ -50,6 +51,10 @@ paper-tables: venv
 # The search that reconstructs Example 1's geometry from the paper's numbers (~2 min).
 paper-ex1-geometry: venv
 	$(BIN)/python benchmarks/paper_ex1_geometry.py --figure docs/images/paper_ex1_geometry.png
+
+# Cattaneo-Mindlin with two identical cylinders on three meshes, and the README picture (~1-2 min).
+cattaneo-mindlin: venv
+	$(BIN)/python benchmarks/cattaneo_mindlin.py --out $(OUT)/bench --figure docs/images/cattaneo_mindlin.png
 
 lint: venv
 	$(BIN)/ruff check fenics_contact tests demos benchmarks

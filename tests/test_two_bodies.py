@@ -256,6 +256,9 @@ def test_two_body_scenes_load() -> None:
          "knot [0.5, 0.0]"),
         (lambda s: s.replace('value = [0.0, -0.02]',
                              'path = [[0.0, 0.0, 0.0], [0.5, 0.0, 1.0]]'), "must increase"),
+        (lambda s: s.replace("relative = true", "relative = true\nmu = -0.1"),
+         "[[pair]] mu = -0.1: the friction coefficient must be >= 0"),
+        (lambda s: s + '\n[output]\nfields = ["slip"]\n', "friction fields need [[pair]] mu"),
     ],
 )
 def test_two_body_scene_errors(tmp_path, edit, message: str) -> None:

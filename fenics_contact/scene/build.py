@@ -221,7 +221,7 @@ def contact_facets(scene: Scene, body: BodyMesh, obstacle: RigidObstacle) -> np.
 
 
 def build_two_body_problem(scene: Scene, body: BodyMesh) -> TwoBodyProblem:
-    """Bodies, conditions and the contact pair of a two-body scene."""
+    """Bodies, conditions and the contact pair of a two-body scene (with [[pair]] mu: friction)."""
     from fenics_contact.model.pairs import Body, PathDisplacement, TwoBodyProblem
 
     comm = body.domain.comm

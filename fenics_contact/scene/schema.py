@@ -25,6 +25,9 @@ Layout (units are the user's; be consistent)::
                  mu (Coulomb friction coefficient, >= 0; absent: frictionless),
                  tangential_r_max (cap of the tangential parameter r_t =
                  min(r, tangential_r_max E/h); default 0.1)
+    [[body]]     name, tag (cell tag), law, E, nu      } two deformable bodies
+    [[pair]]     striker, target (facet tags), r,     } instead of [material],
+                 relative, mu, tangential_r_max       } [obstacle], [contact]
     [solver]     method, steps, max_iterations, atol, rtol, max_cutbacks,
                  predictor = "extrapolate" (start a step from the linear
                  extrapolation of the last two) | "previous",
