@@ -37,7 +37,7 @@ def _scene(mu=MU):
     return dataclasses.replace(scene, contact=dataclasses.replace(scene.contact, mu=mu))
 
 
-def solve(method="gnrm", r=1.0, mu=MU, cutbacks=0, tangential_r_max=0.1):
+def solve(method="gnrm", r=1.0, mu=MU, cutbacks=0, tangential_r_max=2.0):
     scene = _scene(mu)
     scene = dataclasses.replace(
         scene, contact=dataclasses.replace(scene.contact, tangential_r_max=tangential_r_max)

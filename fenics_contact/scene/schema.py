@@ -24,7 +24,8 @@ Layout (units are the user's; be consistent)::
     [contact]    tag, or detect = true with margin; r, relative, quadrature,
                  mu (Coulomb friction coefficient, >= 0; absent: frictionless),
                  tangential_r_max (cap of the tangential parameter r_t =
-                 min(r, tangential_r_max E/h); default 0.1)
+                 min(r, tangential_r_max E/L), L the extent of the contact
+                 surface; default 2)
     [solver]     method, steps, max_iterations, atol, rtol, max_cutbacks,
                  predictor = "extrapolate" (start a step from the linear
                  extrapolation of the last two) | "previous",
@@ -159,7 +160,7 @@ class ContactSpec:
     relative: bool = True
     quadrature: str = "nodal"
     mu: float | None = None
-    tangential_r_max: float | None = 0.1
+    tangential_r_max: float | None = 2.0
 
 
 @dataclass(frozen=True)
@@ -540,7 +541,7 @@ def _contact(reader: _Reader) -> ContactSpec:
         relative=reader.flag("relative", True),
         quadrature=reader.choice("quadrature", ("nodal", "gauss"), default="nodal"),
         mu=_friction(reader),
-        tangential_r_max=reader.number("tangential_r_max", 0.1, positive=True),
+        tangential_r_max=reader.number("tangential_r_max", 2.0, positive=True),
     )
 
 
