@@ -21,6 +21,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import time
+from pathlib import Path
 
 import harness
 
@@ -64,7 +65,7 @@ def main() -> None:
     parser.add_argument("--rule", choices=("body", "mesh"), default="body")
     parser.add_argument("--cap", type=float, default=0.1, help="mesh rule: cap in E/h")
     parser.add_argument("--name", default="friction_rt")
-    parser.add_argument("--out", default=harness.OUT)
+    parser.add_argument("--out", type=Path, default=harness.OUT)
     args = parser.parse_args()
     records, rows = [], []
     for k in (int(v) for v in args.meshes.split(",")):
@@ -83,8 +84,7 @@ def main() -> None:
     header = ["mesh", "method", "r (E/h)", "status", "steps", "Newton its", "max its/step",
               "F_t/(mu N)", "final r_t (E/h)", "switches", "wall s"]
     table = harness.md_table(header, rows)
-    harness.write(args.name, {"machine": harness.machine(), "records": records}, table,
-                  harness.Path(args.out))
+    harness.write(args.name, {"machine": harness.machine(), "records": records}, table, args.out)
     print(table)
 
 

@@ -30,6 +30,8 @@ class GeneralizedNewton(NewtonStrategy):
         return problem.augmented_system()
 
     def _solve(self) -> SolveResult:
+        if not hasattr(self.problem, "lower_tangential_r"):  # frictionless: plain Newton
+            return super()._solve()
         saved = self.problem.snapshot()
         results = [super()._solve()]
 
