@@ -210,6 +210,23 @@ def signorini_report(gap: np.ndarray, pressure: np.ndarray, comm) -> SignoriniRe
     )
 
 
+def _first_violation(
+    settings: SolverSettings,
+    h: float,
+    E: float,
+    lengths: Sequence[tuple[str, float]],
+    stresses: Sequence[tuple[str, float]],
+) -> str | None:
+    """The first named length beyond gap_tol h or stress beyond tension_tol E, as a sentence."""
+    for name, value in lengths:
+        if value > settings.gap_tol * h:
+            return f"{name} {value:.3g} > gap_tol * h = {settings.gap_tol:g} * {h:.3g}"
+    for name, value in stresses:
+        if value > settings.tension_tol * E:
+            return f"{name} {value:.3g} > tension_tol * E = {settings.tension_tol:g} * {E:g}"
+    return None
+
+
 def signorini_admissibility(
     problem, settings: SolverSettings
 ) -> Callable[[], str | None] | None:
@@ -236,14 +253,9 @@ def signorini_admissibility(
         tension = problem.comm.allreduce(
             float(np.max(state.multiplier, initial=0.0)), op=MPI.MAX
         )
-        if state.max_penetration > settings.gap_tol * h:
-            return (
-                f"penetration {state.max_penetration:.3g} > gap_tol * h = "
-                f"{settings.gap_tol:g} * {h:.3g}"
-            )
-        if tension > settings.tension_tol * E:
-            return f"tension {tension:.3g} > tension_tol * E = {settings.tension_tol:g} * {E:g}"
-        return None
+        return _first_violation(
+            settings, h, E, [("penetration", state.max_penetration)], [("tension", tension)]
+        )
 
     return check
 
@@ -271,15 +283,10 @@ def coulomb_admissibility(
 
     def check() -> str | None:
         slip, mismatch, excess = problem.coulomb_violations()
-        if slip > settings.gap_tol * h:
-            return (
-                f"slip at sticking nodes {slip:.3g} > gap_tol * h = "
-                f"{settings.gap_tol:g} * {h:.3g}"
-            )
-        for name, value in (("|tau - lam_t|", mismatch), ("|lam_t| - mu |p_n|", excess)):
-            if value > settings.tension_tol * E:
-                return f"{name} = {value:.3g} > tension_tol * E = {settings.tension_tol:g} * {E:g}"
-        return None
+        return _first_violation(
+            settings, h, E, [("slip at sticking nodes", slip)],
+            [("|tau - lam_t|", mismatch), ("|lam_t| - mu |p_n|", excess)],
+        )
 
     return check
 
