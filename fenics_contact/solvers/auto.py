@@ -17,10 +17,10 @@ This strategy
    continuation (factor ``continuation_factor`` a rung), warm-starting each
    rung from the last;
 2. runs each rung as plain GNRM (identical iterates to ``gnrm`` when the
-   user's r is inside the window; with friction, like ``gnrm``, retried with
-   r_t halved when the stick/slip pattern cycles); if that fails it restarts the rung with
+   user's r is inside the window); if that fails it restarts the rung with
    a line-searched GNRM (backtracking on the residual norm, non-monotone
-   over the last three residuals), and if that fails too it warm-starts
+   over the last three residuals), with friction retried with r_t halved
+   when that cycles, and if that fails too it warm-starts
    from a penalty solution (lam = min(r g, 0)) and runs the line search
    again;
 3. never demands less than the round-off floor: each rung's tolerance is
@@ -69,9 +69,9 @@ class AutoSettings:
         min_damping: smallest line-search step length tried.
         armijo: sufficient-decrease constant of the line search.
         nonmonotone: residuals the line search compares against (their max).
-        tangential_halvings: with friction, halvings of r_t tried (plain GNRM
-            from the rung's start) when the stick/slip pattern cycles, before
-            the line search.
+        tangential_halvings: with friction, halvings of r_t tried (line-searched
+            GNRM from the rung's start) when the line search cycles or reaches
+            the iteration limit, before the penalty warm start.
     """
 
     r_window: tuple[float, float] = (1e-2, 1e2)
@@ -170,15 +170,15 @@ class AutoStrategy(NewtonStrategy):
         p = self.problem
         saved = p.snapshot()
         status = self._newton(settings, tally, line_search=False)
-        status = retry_lowering_r_t(
-            p, saved, status, lambda: self._newton(settings, tally, line_search=False),
-            self.auto.tangential_halvings, tally.switches, "gnrm",
-        )
         if status is Status.CONVERGED:
             return status
         tally.switches.append(f"gnrm {status.value} at r = {p.r_absolute:.3g}: line search")
         self._restore(saved)
         status = self._newton(settings, tally, line_search=True)
+        status = retry_lowering_r_t(
+            p, saved, status, lambda: self._newton(settings, tally, line_search=True),
+            self.auto.tangential_halvings, tally.switches, "line search",
+        )
         if status is Status.CONVERGED:
             return status
         tally.switches.append(f"line search {status.value}: penalty warm start")
