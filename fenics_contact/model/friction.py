@@ -36,11 +36,13 @@ Curnier keep separate normal and tangential parameters). What bounds r_t is
 the tangential stiffness of the body (about E/L per unit area for a
 contact zone of size L), not that of one element (E/h): measured on the
 sliding block (G/H = E/L = 1000), GNRM converges for r_t = 1 ... 3 E/L on
-every mesh from 10x5 to 160x80 and cycles at the first sliding step for
-r_t >= 4 E/L (a large r_t makes y the slip of the current iterate, so the
-stick/slip guess flips sign between iterates); a cap of 0.1 E/h grew with
-refinement past that limit. :meth:`lower_tangential_r` halves r_t (a
-Constant: no recompilation) when a strategy sees the pattern cycle.
+every mesh from 20x10 to 160x80 and cycles at the first sliding step for
+r_t = 4 E/L on 40x20 ... 160x80 (a large r_t makes y the slip of the
+current iterate, so the stick/slip guess flips sign between iterates); a
+cap of 0.1 E/h grew with refinement past that limit. Below about 0.7 E/L
+(fine meshes) it can cycle at partial slip too. :meth:`lower_tangential_r`
+halves r_t (a Constant: no recompilation) when a strategy sees the
+pattern cycle.
 
 Friction has no potential: the residuals are written directly and the
 (unsymmetric) Jacobian is ``ufl.derivative`` of them. The norm |y| is guarded
@@ -171,9 +173,8 @@ class FrictionalContactProblem(ContactProblem):
             np.isfinite(tangential_r_max) and tangential_r_max > 0
         ):
             raise ValueError(
-                f"tangential_r_max must be finite and > 0 (relative to E/L, L the extent of "
-                f"the contact surface), got "
-                f"{tangential_r_max}; None makes r_t = r."
+                f"tangential_r_max must be finite and > 0 (relative to E/L, L the extent "
+                f"of the contact surface), got {tangential_r_max}; None makes r_t = r."
             )
         super().__init__(*args, **kwargs)
         domain = self.domain
