@@ -14,7 +14,7 @@ from mpi4py import MPI
 
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.friction import SLIP, STICK, FrictionalContactProblem
-from fenics_contact.model.scaling import force_scale
+from fenics_contact.model.scaling import force_scale, scaled_atol
 from fenics_contact.scene.build import build_problem
 from fenics_contact.scene.schema import SceneError, load_scene
 from fenics_contact.solvers import make_strategy
@@ -26,7 +26,7 @@ SCENE = Path(__file__).parent.parent / "scenes" / "block_slide_friction.toml"
 MU = 0.3
 PRESS_STEPS = 8  # the plane moves up over load factors 0 ... 0.4 (8 of 20 steps)
 
-#: Serial reference (GNRM, r = 1 E/h, r_t = 0.1 E/h): iterations per step and final forces.
+#: Serial reference (GNRM, r = 1 E/h, r_t = 2 E/L = 0.1 E/h): iterations per step and forces.
 SERIAL_ITERATIONS = [2] * 8 + [3, 3, 4, 4, 3, 3, 3] + [0] * 5
 SERIAL_NORMAL_FORCE = 19.275879891775713
 SERIAL_TANGENTIAL_FORCE = 5.782763967532714
@@ -37,7 +37,7 @@ def _scene(mu=MU):
     return dataclasses.replace(scene, contact=dataclasses.replace(scene.contact, mu=mu))
 
 
-def solve(method="gnrm", r=1.0, mu=MU, cutbacks=0, tangential_r_max=0.1):
+def solve(method="gnrm", r=1.0, mu=MU, cutbacks=0, tangential_r_max=2.0):
     scene = _scene(mu)
     scene = dataclasses.replace(
         scene, contact=dataclasses.replace(scene.contact, tangential_r_max=tangential_r_max)
@@ -218,7 +218,7 @@ def test_answer_does_not_depend_on_r(gnrm_run):
                       ("gnrm", 1e4), ("auto", 1e-2), ("auto", 1e2)]:
         problem, run = solve(method, r)
         assert run.converged, (method, r)
-        if method == "gnrm" and r >= 0.1:  # r_t = 0.1 E/h for all of them
+        if method == "gnrm" and r >= 0.1:  # r_t = 2 E/L = 0.1 E/h for all of them
             assert [s.iterations for s in run.steps] == SERIAL_ITERATIONS
         assert np.max(np.abs(problem.u.x.array - u_ref)) < 1e-8 * scale, (method, r)
         assert run.steps[-1].tangential_force == pytest.approx(
@@ -227,10 +227,17 @@ def test_answer_does_not_depend_on_r(gnrm_run):
 
 
 def test_uncapped_tangential_r_makes_gnrm_stall_where_sliding_starts():
-    """The reason for r_t = min(r, 0.1 E/h): with r_t = r = 1 E/h the stick/slip guess flips."""
-    _, run = solve("gnrm", 1.0, tangential_r_max=None)
+    """The reason for r_t = min(r, 2 E/L): with r_t = r = 1 E/h = 20 E/L the guess flips.
+
+    GNRM halves r_t twice (to 5 E/L, still above the measured limit of
+    about 3.5 E/L) and, failing, puts the cap back.
+    """
+    problem, run = solve("gnrm", 1.0, tangential_r_max=None)
     assert run.status == "max_iterations"
     assert run.steps_completed == PRESS_STEPS
+    halved = [s for s in run.switches if "r_t halved" in s]
+    assert len(halved) == 2 and "5e+03" in halved[-1]
+    assert problem.tangential_cap == np.inf
 
 
 def test_penalty_slides_at_mu_times_its_normal_force():
@@ -378,3 +385,107 @@ def test_iterative_linear_solver_takes_both_multipliers_in_one_split():
     run = solve_load_path(strategy, 20, max_cutbacks=0)
     assert [s.iterations for s in run.steps] == SERIAL_ITERATIONS
     assert run.steps[-1].tangential_force == pytest.approx(SERIAL_TANGENTIAL_FORCE, rel=1e-8)
+
+
+def test_tangential_cap_follows_the_body_not_the_mesh():
+    """r_t = min(r, 2 E/L), L = 1 the contact surface extent: 2000 on every mesh (E/h grows)."""
+    for k in (1, 2, 4):
+        problem = SlidingBlock(nx=10 * k, ny=5 * k).build(ContactSettings(r=1.0, relative=True))
+        assert problem.contact_extent == pytest.approx(1.0, rel=1e-12)
+        assert problem.tangential_r == pytest.approx(2000.0, rel=1e-12)
+        assert problem.stiffness_scale == pytest.approx(1e4 * k, rel=1e-12)
+
+
+def _refined_run(cap=None):
+    """GNRM at r = 1 E/h on the 40x20 block (stopping test of the trade-off sweep)."""
+    problem = SlidingBlock(nx=40, ny=20).build(ContactSettings(r=1.0, relative=True))
+    if cap is not None:
+        problem.set_tangential_cap(cap)
+    settings = SolverSettings(atol=scaled_atol(problem), max_iterations=200)
+    return problem, solve_load_path(make_strategy("gnrm", problem, settings), 20, max_cutbacks=0)
+
+
+def test_refined_block_slides_and_gnrm_halves_r_t_where_the_pattern_cycles():
+    """40x20: the former cap 0.1 E/h = 4000 made GNRM cycle at the first sliding step.
+
+    Measured: 43 iterations with r_t = 2 E/L = 2000; with the former cap GNRM
+    cycles (13 iterations), halves r_t to 2000 and goes on (56 in all); the
+    same answer either way.
+    """
+    problem, run = _refined_run()
+    assert run.converged and run.iterations <= 45 and not run.switches
+    final = run.steps[-1]
+    assert final.tangential_force / (MU * final.contact_force) == pytest.approx(1.0, rel=1e-10)
+    former, rescued = _refined_run(cap=0.1 * problem.stiffness_scale)
+    assert rescued.converged and rescued.iterations <= 60
+    halved = [s for s in rescued.switches if "r_t halved" in s]
+    assert len(halved) == 1 and "gnrm cycling" in halved[0]
+    assert former.tangential_r == pytest.approx(2000.0, rel=1e-12)  # the lowered cap stays
+    scale = np.max(np.abs(problem.u.x.array))
+    assert np.max(np.abs(former.u.x.array - problem.u.x.array)) < 1e-8 * scale
+
+
+@pytest.mark.mpi
+def test_coulomb_check_passes_gnrm_answers_and_fails_off_the_law():
+    """The check in its own units: slip at sticking nodes, |tau - lam_t|, Coulomb excess."""
+    from fenics_contact.solvers.diagnostics import coulomb_admissibility
+
+    problem, _ = solve()  # GNRM's converged answer, every node slipping
+    settings = SolverSettings()  # gap_tol = tension_tol = 1e-6: 5e-8 (h = 0.05), 1e-3 (E = 1e3)
+    check = coulomb_admissibility(problem, settings)
+    assert check() is None
+    slip, mismatch, excess = problem.coulomb_violations()
+    assert slip == 0.0 and mismatch < 1e-9 and excess < 1e-9
+    problem.commit()  # zero slip increment, then stick inside the disc
+    problem.lam_t.x.array[:] *= 0.5
+    assert check() is None
+    assert problem.contact_state().stick_count == 21
+    problem.u.x.array[0::2] += 1e-6  # every node slides 1e-6 while sticking
+    assert problem.coulomb_violations()[0] == pytest.approx(1e-6, rel=1e-6)
+    assert "slip at sticking nodes" in check()
+    problem.u.x.array[0::2] -= 1e-6
+    problem.lam_t.x.array[:] *= 3.0  # 1.5 times the Coulomb limit
+    assert "|tau - lam_t|" in check()
+    limit = problem.comm.allreduce(
+        float(np.max(problem.contact_state().coulomb_limit, initial=0.0)), op=MPI.MAX
+    )
+    assert problem.coulomb_violations()[2] == pytest.approx(0.5 * limit, rel=1e-6)
+    assert coulomb_admissibility(build_problem(_scene(mu=None)), settings) is None
+
+
+#: The sliding block's path up to its first sliding step (steps 1-9 of 20), in 9 steps.
+FIRST_SLIDE = ((0.0, 0.0, 0.0), (8.0 / 9.0, 0.0, 0.01), (1.0, 0.02 / 12.0, 0.01))
+
+
+def test_sua_at_huge_r_is_not_converged_until_the_coulomb_law_holds(monkeypatch):
+    """SUA at r = 1e8 E/h: the raised tolerance (normal round-off floor) let it stop off the law.
+
+    Measured at the first sliding step: without the Coulomb check 16
+    iterations, slip 1.8e-6 at sticking nodes (36 gap_tol h) and
+    |tau - lam_t| = 3.6e-3; with it 45 iterations and slip 4.7e-8.
+    """
+    import fenics_contact.solvers.base as base
+    from fenics_contact.solvers.diagnostics import coulomb_admissibility, signorini_admissibility
+
+    block = SlidingBlock(schedule=FIRST_SLIDE, steps=9)
+
+    def first_slide():
+        problem = block.build(ContactSettings(r=1e8, relative=True))
+        settings = SolverSettings(atol=scaled_atol(problem), max_iterations=100)
+        verdicts = []
+
+        def judge(_):
+            verdicts.append(coulomb_admissibility(problem, settings)())
+
+        run = solve_load_path(make_strategy("sua", problem, settings), 9, max_cutbacks=0,
+                              on_step=judge)
+        return problem, run, verdicts
+
+    problem, run, verdicts = first_slide()
+    assert run.converged and verdicts == [None] * 9
+    assert run.steps[-1].iterations >= 30
+    assert problem.coulomb_violations()[0] <= 1e-6 * problem.surface.h
+    monkeypatch.setattr(base, "contact_admissibility", signorini_admissibility)
+    _, former, verdicts = first_slide()  # the Signorini check only, as before
+    assert former.converged and former.steps[-1].iterations < 20
+    assert verdicts[:8] == [None] * 8 and "slip at sticking nodes" in verdicts[-1]

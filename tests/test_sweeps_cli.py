@@ -60,7 +60,7 @@ def test_tradeoff_friction_group_scores_the_coulomb_law(tmp_path):
         assert gnrm["status"] == "converged" and float(gnrm["mu"]) == 0.3
         assert float(gnrm["ft_error"]) < 1e-12 and float(gnrm["stick_slip"]) < 1e-12
         assert float(gnrm["u_error"]) < 1e-12 and float(gnrm["t_residual"]) < 1e-8
-    # penalty at r = 1 E/h (r_t = 0.1 E/h): sticking nodes creep (measured 1.3e-3 against a
+    # penalty at r = 1 E/h (r_t = 2 E/L = 0.2 E/h): sticking nodes creep (measured 1.3e-3 against a
     # 0.02 slide) and it slides fully later than the reference (F_t 15 % below mu N there)
     penalty = rows[("penalty", 1.0)]
     assert penalty["status"] == "converged" and penalty["t_residual"] == "nan"  # no lam_t

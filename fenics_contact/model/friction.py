@@ -33,13 +33,20 @@ like the normal one): stick gives dg_t = 0 with |lam_t| <= rho, slip gives
 hold at the nodes whatever r, r_t > 0, so the converged answer depends on
 neither.
 
-The tangential parameter is r_t = min(r, tangential_r_max E/h), with
-tangential_r_max = 0.1 by default (Alart and Curnier keep separate normal
-and tangential parameters). Measured on the sliding block: with r_t = r,
-GNRM stalls at the first sliding increment for every r >= 0.3 E/h (the
-stick/slip guess flips sign between iterates: a large r_t makes y the slip
-of the current iterate), while with the cap it takes the same 39
-iterations for r = 1e-3 ... 1e4 E/h.
+The tangential parameter is r_t = min(r, tangential_r_max E/L), with L
+the extent of the candidate contact surface (diagonal of its bounding box,
+reference configuration) and tangential_r_max = 2 by default (Alart and
+Curnier keep separate normal and tangential parameters). What bounds r_t is
+the tangential stiffness of the body (about E/L per unit area for a
+contact zone of size L), not that of one element (E/h): measured on the
+sliding block (G/H = E/L = 1000), GNRM converges for r_t = 1 ... 3 E/L on
+every mesh from 20x10 to 160x80 and cycles at the first sliding step for
+r_t = 4 E/L on 40x20 ... 160x80 (a large r_t makes y the slip of the
+current iterate, so the stick/slip guess flips sign between iterates); a
+cap of 0.1 E/h grew with refinement past that limit. Below about 0.7 E/L
+(fine meshes) it can cycle at partial slip too. :meth:`lower_tangential_r`
+halves r_t (a Constant: no recompilation) when a strategy sees the
+pattern cycle.
 
 Friction has no potential: the residuals are written directly and the
 (unsymmetric) Jacobian is ``ufl.derivative`` of them. The norm |y| is guarded
@@ -57,7 +64,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import ufl
-from dolfinx import default_scalar_type, fem
+from dolfinx import default_scalar_type, fem, mesh
 
 from mpi4py import MPI
 
@@ -104,6 +111,16 @@ def coulomb_projection(
     """
     norm = ufl.sqrt(ufl.dot(y, y) + eps**2)
     return ufl.conditional(ufl.lt(norm, rho), 1.0, rho / norm) * y
+
+
+def surface_extent(submesh: mesh.Mesh) -> float:
+    """Diagonal of the bounding box of a (contact) submesh, global over ranks (length)."""
+    x = submesh.geometry.x
+    comm = submesh.comm
+    low, high = np.min(x, axis=0, initial=np.inf), np.max(x, axis=0, initial=-np.inf)
+    comm.Allreduce(MPI.IN_PLACE, low, op=MPI.MIN)
+    comm.Allreduce(MPI.IN_PLACE, high, op=MPI.MAX)
+    return float(np.linalg.norm(high - low))
 
 
 @dataclass(frozen=True)
@@ -153,8 +170,8 @@ def check_friction(mu: float, tangential_r_max: float | None) -> None:
         np.isfinite(tangential_r_max) and tangential_r_max > 0
     ):
         raise ValueError(
-            f"tangential_r_max must be finite and > 0 (relative to E/h), got "
-            f"{tangential_r_max}; None makes r_t = r."
+            f"tangential_r_max must be finite and > 0 (relative to E/L, L the extent of "
+            f"the contact surface), got {tangential_r_max}; None makes r_t = r."
         )
 
 
@@ -182,7 +199,7 @@ class FrictionMixin:
     gap: ufl.core.expr.Expr
 
     def __init__(
-        self, *args, mu: float, tangential_r_max: float | None = 0.1, **kwargs
+        self, *args, mu: float, tangential_r_max: float | None = 2.0, **kwargs
     ) -> None:
         """Check mu and the cap, build the host problem, then the friction terms."""
         check_friction(mu, tangential_r_max)
@@ -206,12 +223,16 @@ class FrictionMixin:
             lam_t = self.lam_t
         self.u_prev = fem.Function(self.V, name="displacement_prev")
         self.tangents, self.slip = self._slip_increment()
-        #: Tangential parameter r_t = min(r, tangential_r_max E/h) (stress/length);
-        #: follows r when a strategy changes it.
-        self.r_t: ufl.core.expr.Expr = self.r
-        if tangential_r_max is not None:
-            cap = fem.Constant(domain, default_scalar_type(tangential_r_max * self.stiffness_scale))
-            self.r_t = ufl.min_value(self.r, cap)
+        #: Extent L of the candidate contact surface (length).
+        self.contact_extent = surface_extent(self.surface.submesh)
+        #: Tangential parameter r_t = min(r, r_t_cap), r_t_cap = tangential_r_max E/L
+        #: (stress/length, E the modulus of the r scale); follows r when a strategy
+        #: changes it.
+        modulus = self.stiffness_scale * self.surface.h  # type: ignore[attr-defined]
+        cap = (np.inf if tangential_r_max is None
+               else tangential_r_max * modulus / self.contact_extent)
+        self.r_t_cap = fem.Constant(domain, default_scalar_type(cap))
+        self.r_t: ufl.core.expr.Expr = ufl.min_value(self.r, self.r_t_cap)
         self.trial_traction = lam_t + self.r_t * self.slip
         self.coulomb_radius = -self.mu * self.pressure
         self.traction_t = coulomb_projection(self.trial_traction, self.coulomb_radius, self.eps)
@@ -281,6 +302,31 @@ class FrictionMixin:
         super().restore(state, load=load)  # type: ignore[misc]
         if isinstance(state, FrictionalProblemState) and state.lam_t.size:
             self.lam_t.x.array[:] = state.lam_t
+
+    @property
+    def tangential_r(self) -> float:
+        """The current tangential parameter r_t = min(r, cap) (stress per length)."""
+        return min(self.r_absolute, float(self.r_t_cap.value))
+
+    @property
+    def tangential_cap(self) -> float:
+        """The cap of r_t (stress per length; inf when r_t = r)."""
+        return float(self.r_t_cap.value)
+
+    def set_tangential_cap(self, cap: float) -> None:
+        """Set the cap of r_t (absolute, stress per length; inf: r_t = r). No recompilation."""
+        if not cap > 0:
+            raise ValueError(f"The cap of r_t must be > 0 (stress per length), got {cap}.")
+        self.r_t_cap.value = cap
+
+    def lower_tangential_r(self, factor: float = 0.5) -> float:
+        """Cap r_t at ``factor`` times its current value; return the new r_t (stress/length).
+
+        The converged nodal answer does not depend on r_t; a smaller r_t
+        keeps the stick/slip guess from flipping (see the module notes).
+        """
+        self.set_tangential_cap(factor * self.tangential_r)
+        return self.tangential_r
 
     # -- systems -----------------------------------------------------------------------
     def _friction_work(self, traction: ufl.core.expr.Expr) -> Work:
@@ -406,6 +452,26 @@ class FrictionMixin:
             slip_count=comm.allreduce(int(np.sum(states == SLIP)), op=MPI.SUM),
         )
 
+    def coulomb_violations(self) -> tuple[float, float, float]:
+        """Worst nodal violations of the Coulomb conditions, global over ranks.
+
+        Returns (largest |dg_t| at sticking nodes (length), largest
+        |tau - lam_t| (stress), largest |lam_t| - rho (stress)); all zero at
+        an exact nodal solution, whatever r and r_t. Only meaningful with the
+        vertex rule (the conditions hold at the nodes).
+        """
+        slip = np.linalg.norm(self._nodal_components(self._slip_forms), axis=1)
+        tau = self._nodal_components(self._tau_forms)
+        lam_t = self.lam_t.x.array[: tau.size].reshape(tau.shape)
+        rho = self.surface.nodal(self._rho_form)
+        sticks = self.node_states() == STICK
+        local = (
+            float(np.max(slip[sticks], initial=0.0)),
+            float(np.max(np.linalg.norm(tau - lam_t, axis=1), initial=0.0)),
+            float(np.max(np.linalg.norm(lam_t, axis=1) - rho, initial=0.0)),
+        )
+        return tuple(self.comm.allreduce(v, op=MPI.MAX) for v in local)
+
     def complementarity_norms(self) -> tuple[float, float]:
         """Euclidean norms of the normal and tangential complementarity residuals (force)."""
         self.refresh_search()  # type: ignore[attr-defined]
@@ -423,8 +489,8 @@ class FrictionalContactProblem(FrictionMixin, ContactProblem):
     d-1 components), the last converged displacement ``u_prev`` and obstacle
     placement ``c_prev``; :meth:`commit` moves them forward after each
     converged increment. ``tangential_r_max`` caps the tangential parameter
-    r_t = min(r, tangential_r_max E/h) (None: r_t = r). Other arguments as
-    :class:`ContactProblem`.
+    r_t = min(r, tangential_r_max E/L), L the extent of the candidate contact
+    surface (None: r_t = r). Other arguments as :class:`ContactProblem`.
     """
 
     def _slip_increment(self) -> tuple[ufl.core.expr.Expr, ufl.core.expr.Expr]:

@@ -44,7 +44,8 @@ class FrictionalTwoBodyProblem(FrictionMixin, TwoBodyProblem):
     """Two deformable bodies with Coulomb friction of coefficient ``mu``.
 
     Arguments as :class:`TwoBodyProblem` plus ``mu`` and ``tangential_r_max``
-    (r_t = min(r, tangential_r_max E/h), E the pair modulus; None: r_t = r).
+    (r_t = min(r, tangential_r_max E/L), E the pair modulus, L the extent of
+    the striker's contact surface; None: r_t = r).
     :meth:`commit` moves u_prev and the target's previous displacements
     forward; the stepping calls it before each increment.
     """

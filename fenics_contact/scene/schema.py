@@ -24,7 +24,8 @@ Layout (units are the user's; be consistent)::
     [contact]    tag, or detect = true with margin; r, relative, quadrature,
                  mu (Coulomb friction coefficient, >= 0; absent: frictionless),
                  tangential_r_max (cap of the tangential parameter r_t =
-                 min(r, tangential_r_max E/h); default 0.1)
+                 min(r, tangential_r_max E/L), L the extent of the contact
+                 surface; default 2)
     [[body]]     name, tag (cell tag), law, E, nu      } two deformable bodies
     [[pair]]     striker, target (facet tags), r,     } instead of [material],
                  relative, mu, tangential_r_max       } [obstacle], [contact]
@@ -145,7 +146,7 @@ class PairSpec:
     r: float = 1.0
     relative: bool = True
     mu: float | None = None
-    tangential_r_max: float | None = 0.1
+    tangential_r_max: float | None = 2.0
 
 
 @dataclass(frozen=True)
@@ -172,7 +173,7 @@ class ContactSpec:
     relative: bool = True
     quadrature: str = "nodal"
     mu: float | None = None
-    tangential_r_max: float | None = 0.1
+    tangential_r_max: float | None = 2.0
 
 
 @dataclass(frozen=True)
@@ -477,7 +478,7 @@ def _pairs(path: Path, data: dict[str, Any]) -> tuple[PairSpec, ...]:
             striker=reader.tag("striker"), target=reader.tag("target"),
             r=_contact_r(reader), relative=reader.flag("relative", True),
             mu=_friction(reader),
-            tangential_r_max=reader.number("tangential_r_max", 0.1, positive=True),
+            tangential_r_max=reader.number("tangential_r_max", 2.0, positive=True),
         ))
     if len(out) > 1:
         raise SceneError(f"{path.name}: {len(out)} [[pair]] blocks; one contact pair per scene "
@@ -555,7 +556,7 @@ def _contact(reader: _Reader) -> ContactSpec:
         relative=reader.flag("relative", True),
         quadrature=reader.choice("quadrature", ("nodal", "gauss"), default="nodal"),
         mu=_friction(reader),
-        tangential_r_max=reader.number("tangential_r_max", 0.1, positive=True),
+        tangential_r_max=reader.number("tangential_r_max", 2.0, positive=True),
     )
 
 

@@ -19,7 +19,8 @@ This strategy
 2. runs each rung as plain GNRM (identical iterates to ``gnrm`` when the
    user's r is inside the window); if that fails it restarts the rung with
    a line-searched GNRM (backtracking on the residual norm, non-monotone
-   over the last three residuals), and if that fails too it warm-starts
+   over the last three residuals), with friction retried with r_t halved
+   when that cycles, and if that fails too it warm-starts
    from a penalty solution (lam = min(r g, 0)) and runs the line search
    again;
 3. never demands less than the round-off floor: each rung's tolerance is
@@ -40,13 +41,20 @@ from dolfinx.fem import petsc as fem_petsc
 
 from fenics_contact.model.problem import ContactProblem, ProblemState, VariationalSystem
 from fenics_contact.model.scaling import residual_floor
-from fenics_contact.solvers.base import NewtonStrategy, Observer, SolveResult, newton_loop, timed
+from fenics_contact.solvers.base import (
+    NewtonStrategy,
+    Observer,
+    SolveResult,
+    newton_loop,
+    retry_lowering_r_t,
+    timed,
+)
 from fenics_contact.solvers.condensed import kernel_for
 from fenics_contact.solvers.diagnostics import (
     ConvergenceMonitor,
     SolverSettings,
     Status,
-    signorini_admissibility,
+    contact_admissibility,
 )
 from fenics_contact.solvers.newton import NewtonKernel
 
@@ -61,6 +69,9 @@ class AutoSettings:
         min_damping: smallest line-search step length tried.
         armijo: sufficient-decrease constant of the line search.
         nonmonotone: residuals the line search compares against (their max).
+        tangential_halvings: with friction, halvings of r_t tried (line-searched
+            GNRM from the rung's start) when the line search cycles or reaches
+            the iteration limit, before the penalty warm start.
     """
 
     r_window: tuple[float, float] = (1e-2, 1e2)
@@ -68,6 +79,7 @@ class AutoSettings:
     min_damping: float = 1.0 / 64.0
     armijo: float = 1e-4
     nonmonotone: int = 3
+    tangential_halvings: int = 2
 
 
 @dataclass
@@ -163,6 +175,10 @@ class AutoStrategy(NewtonStrategy):
         tally.switches.append(f"gnrm {status.value} at r = {p.r_absolute:.3g}: line search")
         self._restore(saved)
         status = self._newton(settings, tally, line_search=True)
+        status = retry_lowering_r_t(
+            p, saved, status, lambda: self._newton(settings, tally, line_search=True),
+            self.auto.tangential_halvings, tally.switches, "line search",
+        )
         if status is Status.CONVERGED:
             return status
         tally.switches.append(f"line search {status.value}: penalty warm start")
@@ -213,7 +229,7 @@ class AutoStrategy(NewtonStrategy):
         """Newton on the Alart-Curnier system, plain or with backtracking."""
         monitor = ConvergenceMonitor(
             settings, observer=self._progress(tally),
-            admissible=signorini_admissibility(self.problem, settings),
+            admissible=contact_admissibility(self.problem, settings),
         )
         if line_search:
             status, steps = self._line_search_loop(self.kernel, monitor)

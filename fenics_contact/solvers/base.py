@@ -13,7 +13,7 @@ from fenics_contact.solvers.diagnostics import (
     ConvergenceMonitor,
     SolverSettings,
     Status,
-    signorini_admissibility,
+    contact_admissibility,
 )
 from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.newton import NewtonKernel
@@ -89,6 +89,47 @@ def newton_loop(
             after_step()
 
 
+#: Failures after which a frictional solve is retried with r_t halved: the
+#: stick/slip pattern cycled (or never settled within the iteration limit).
+TANGENTIAL_RETRY = (Status.CYCLING, Status.MAX_ITERATIONS)
+
+
+def retry_lowering_r_t(
+    problem: ContactProblem,
+    saved: object,
+    status: Status,
+    attempt: Callable[[], Status],
+    halvings: int,
+    switches: list[str],
+    label: str,
+) -> Status:
+    """Retry a failed frictional solve from ``saved`` with r_t halved, up to ``halvings`` times.
+
+    Only for problems that can lower r_t (friction) and a ``status`` in
+    :data:`TANGENTIAL_RETRY`. ``attempt`` solves from the restored state and
+    returns its status; each halving is appended to ``switches``. When every
+    attempt fails the cap of r_t is put back (the converged nodal answer does
+    not depend on r_t, so a lowered cap is kept only when it helped).
+    """
+    lower = getattr(problem, "lower_tangential_r", None)
+    if lower is None or status not in TANGENTIAL_RETRY:
+        return status
+    cap = problem.tangential_cap
+    for _ in range(halvings):
+        problem.restore(saved, load=False)
+        r_t = lower()
+        switches.append(
+            f"{label} {status.value} with friction: r_t halved to {r_t:.3g} "
+            f"({r_t / problem.stiffness_scale:.3g} E/h)"
+        )
+        status = attempt()
+        if status not in TANGENTIAL_RETRY:
+            break
+    if status is not Status.CONVERGED:
+        problem.set_tangential_cap(cap)
+    return status
+
+
 def timed(fn: Callable[[], SolveResult]) -> SolveResult:
     """Run a solve and store its wall time in the result."""
     start = time.perf_counter()
@@ -147,7 +188,7 @@ class NewtonStrategy:
         settings = settings or self.settings
         return ConvergenceMonitor(
             settings, observer=self.observer,
-            admissible=signorini_admissibility(self.problem, settings)
+            admissible=contact_admissibility(self.problem, settings)
             if self.exact_constraint else None,
         )
 

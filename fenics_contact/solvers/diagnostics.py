@@ -10,7 +10,10 @@ Statuses, with their defined tests (checked in this order each iteration):
   nodal penetration beyond ``gap_tol`` times the contact facet size and no
   multiplier tension beyond ``tension_tol`` times E. A small residual alone
   does not suffice: at tiny r the force-scaled complementarity residual
-  r g hides a gap.
+  r g hides a gap. With friction the Coulomb conditions are tested too
+  (:func:`coulomb_admissibility`): no slip beyond ``gap_tol`` h at
+  sticking nodes, tangential complementarity and Coulomb excess within
+  ``tension_tol`` E.
 - ``cycling``: over the last ``cycle_window`` iterations the residual never
   fell below the smallest value seen before that window, and the active set
   (or, without one, the rounded residual) returned to a state it had left
@@ -207,6 +210,23 @@ def signorini_report(gap: np.ndarray, pressure: np.ndarray, comm) -> SignoriniRe
     )
 
 
+def _first_violation(
+    settings: SolverSettings,
+    h: float,
+    E: float,
+    lengths: Sequence[tuple[str, float]],
+    stresses: Sequence[tuple[str, float]],
+) -> str | None:
+    """The first named length beyond gap_tol h or stress beyond tension_tol E, as a sentence."""
+    for name, value in lengths:
+        if value > settings.gap_tol * h:
+            return f"{name} {value:.3g} > gap_tol * h = {settings.gap_tol:g} * {h:.3g}"
+    for name, value in stresses:
+        if value > settings.tension_tol * E:
+            return f"{name} {value:.3g} > tension_tol * E = {settings.tension_tol:g} * {E:g}"
+    return None
+
+
 def signorini_admissibility(
     problem, settings: SolverSettings
 ) -> Callable[[], str | None] | None:
@@ -233,13 +253,63 @@ def signorini_admissibility(
         tension = problem.comm.allreduce(
             float(np.max(state.multiplier, initial=0.0)), op=MPI.MAX
         )
-        if state.max_penetration > settings.gap_tol * h:
-            return (
-                f"penetration {state.max_penetration:.3g} > gap_tol * h = "
-                f"{settings.gap_tol:g} * {h:.3g}"
-            )
-        if tension > settings.tension_tol * E:
-            return f"tension {tension:.3g} > tension_tol * E = {settings.tension_tol:g} * {E:g}"
+        return _first_violation(
+            settings, h, E, [("penetration", state.max_penetration)], [("tension", tension)]
+        )
+
+    return check
+
+
+def coulomb_admissibility(
+    problem, settings: SolverSettings
+) -> Callable[[], str | None] | None:
+    """The Coulomb test of a converged iterate in its own units (friction, vertex rule).
+
+    Beside the Signorini test: the raised stopping tolerance at large r (the
+    round-off floor of the normal residual) covers the whole residual norm,
+    so a small norm does not bound the tangential part. Returns a callable
+    giving None when, at the nodes, the slip increment of sticking nodes is
+    at most ``settings.gap_tol * h``, |tau - lam_t| (the tangential
+    complementarity, stress) and the excess |lam_t| - mu |p_n| over the
+    Coulomb disc at most ``settings.tension_tol * E``; else a sentence naming
+    the violation. None (no test) without friction or with the Gauss rule.
+    """
+    if not hasattr(problem, "coulomb_violations"):
+        return None
+    if getattr(problem.surface, "quadrature", "nodal") != "nodal":
+        return None
+    h = float(problem.surface.h)
+    E = float(problem.material.E)
+
+    def check() -> str | None:
+        slip, mismatch, excess = problem.coulomb_violations()
+        return _first_violation(
+            settings, h, E, [("slip at sticking nodes", slip)],
+            [("|tau - lam_t|", mismatch), ("|lam_t| - mu |p_n|", excess)],
+        )
+
+    return check
+
+
+def contact_admissibility(
+    problem, settings: SolverSettings
+) -> Callable[[], str | None] | None:
+    """The Signorini test, followed by the Coulomb test for frictional problems.
+
+    None when neither applies (Gauss rule).
+    """
+    checks = [
+        c for c in (signorini_admissibility(problem, settings),
+                    coulomb_admissibility(problem, settings)) if c is not None
+    ]
+    if not checks:
+        return None
+
+    def check() -> str | None:
+        for c in checks:
+            reason = c()
+            if reason is not None:
+                return reason
         return None
 
     return check

@@ -7,7 +7,8 @@ E from 1e-3 to 1e12 (displacement loading: forces scale with E), nu up to
 contact, full contact, a very coarse and a fine mesh; and the sliding block
 with Coulomb friction (groups ``friction``: mu from 0 to 10 and a load
 reversal at r = 1 E/h; ``friction-r``: r from 1e-8 to 1e12 E/h at mu = 0.3,
-with the default r_t = min(r, 0.1 E/h) and with r_t = r).
+with the default r_t = min(r, 2 E/L), L the contact surface extent, and with
+r_t = r).
 
 The stopping test is the same for every method and meaningful for any E:
 atol = max(force_rtol * E h^(d-1), round-off floor at r)

@@ -41,7 +41,8 @@ class SlidingBlock:
         width, height: block size (length).
         E, nu: SVK material (nu = 0: no sideways spreading when pressed).
         steps: load steps.
-        tangential_r_max: cap of r_t relative to E/h (None: r_t = r).
+        tangential_r_max: cap of r_t relative to E/L, L the contact surface extent
+            (None: r_t = r).
     """
 
     mu: float = 0.3
@@ -53,7 +54,7 @@ class SlidingBlock:
     E: float = 1000.0
     nu: float = 0.0
     steps: int = 20
-    tangential_r_max: float | None = 0.1
+    tangential_r_max: float | None = 2.0
 
     @property
     def label(self) -> str:
