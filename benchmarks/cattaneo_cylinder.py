@@ -19,13 +19,13 @@ import time
 from pathlib import Path
 
 import harness
+from cattaneo_plot import traction_picture
 
 import fenics_contact  # noqa: F401  (before dolfinx)
 from fenics_contact.verification.cattaneo import (
     CattaneoCylinder,
     contact_profile,
     solve_cattaneo,
-    traction_picture,
 )
 
 CASES = [  # (nu, h_contact, degree, frictionless pressing)

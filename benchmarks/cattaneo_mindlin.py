@@ -27,13 +27,13 @@ import time
 from pathlib import Path
 
 import harness
+from cattaneo_plot import traction_picture
 
 import fenics_contact  # noqa: F401  (before dolfinx)
 from fenics_contact.scene.schema import MeshSpec, load_scene
 from fenics_contact.verification.cattaneo import (
     pressing_check,
     solve_cattaneo_mindlin,
-    traction_picture,
 )
 
 ROOT = Path(__file__).resolve().parents[1]

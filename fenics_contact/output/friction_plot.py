@@ -20,6 +20,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from fenics_contact.model.friction import SLIP, STICK, FrictionalContactProblem
+from fenics_contact.output.plotting import save_figure
 
 
 def friction_profile_data(problem: FrictionalContactProblem) -> dict[str, np.ndarray] | None:
@@ -64,7 +65,4 @@ def friction_profile(problem: FrictionalContactProblem, path: Path, title: str =
     ax.legend(fontsize=8)
     if title:
         ax.set_title(title, fontsize=10)
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path)

@@ -15,6 +15,14 @@ from fenics_contact.solvers import PAPER_NAMES
 from fenics_contact.solvers.stepping import RunRecord
 
 
+def save_figure(fig: plt.Figure, path: Path) -> None:
+    """Lay out, write (PNG at 120 dpi; the folder is created) and close ``fig``."""
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
 def residual_histories(records: Sequence[RunRecord], path: Path) -> None:
     """One semilog panel per method: residual against cumulative iteration, a line per r."""
     methods = list(dict.fromkeys(r.method for r in records))
@@ -30,10 +38,7 @@ def residual_histories(records: Sequence[RunRecord], path: Path) -> None:
         ax.set_xlabel("residual evaluation (all load steps)")
         ax.legend(fontsize=7)
     axes[0][0].set_ylabel("static residual (L2 norm)")
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def iterations_against_r(records: Sequence[RunRecord], path: Path) -> None:
@@ -55,10 +60,7 @@ def iterations_against_r(records: Sequence[RunRecord], path: Path) -> None:
     ax.set_ylabel("Newton iterations, all load steps")
     ax.set_title("open marker: not converged")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def step_residuals(steps: Sequence, path: Path, title: str = "") -> None:
@@ -73,7 +75,4 @@ def step_residuals(steps: Sequence, path: Path, title: str = "") -> None:
     ax.set_title(title)
     if len(steps) <= 12:
         ax.legend(fontsize=7, ncol=2)
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path)

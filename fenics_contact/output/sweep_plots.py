@@ -13,6 +13,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import ListedColormap
 
+from fenics_contact.output.plotting import save_figure
 from fenics_contact.solvers import PAPER_NAMES
 from fenics_contact.studies.stability import CaseRecord
 from fenics_contact.studies.tradeoff import ERROR_FLOOR, TradeoffRecord
@@ -80,10 +81,7 @@ def tradeoff_plot(records: Sequence[TradeoffRecord], path: Path) -> None:
                 else "peak-pressure error vs Hertz (rel.)")
         ax.set_ylabel(what)
         ax.set_title(f"{case}: {'per mesh' if front == 'pareto_u' else 'all meshes'}", fontsize=9)
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def stability_plot(records: Sequence[CaseRecord], path: Path) -> None:
@@ -113,7 +111,4 @@ def stability_plot(records: Sequence[CaseRecord], path: Path) -> None:
               bbox_to_anchor=(0.5, -0.01), frameon=False)
     ax.set_title("status per case and method (Newton iterations, all load steps)", fontsize=9,
                  pad=22)
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path)
