@@ -64,11 +64,15 @@ RADIUS = 0.5
 STEADY = (0.6, 2.4)
 
 
-def run(mu: float | None, coarse: bool) -> dict:
+def run(mu: float | None, coarse: bool, indenter_E: float | None = None) -> dict:
     """One ironing run; ``mu = None`` frictionless. Returns the per-step rows and totals."""
     scene = load_scene(SCENE)
     pair = dataclasses.replace(scene.pairs[0], mu=mu)
     scene = dataclasses.replace(scene, pairs=(pair,))
+    if indenter_E is not None:  # same moduli: Dundurs beta = 0, no normal-tangential coupling
+        bodies = tuple(dataclasses.replace(b, E=indenter_E) if b.name == "indenter" else b
+                       for b in scene.bodies)
+        scene = dataclasses.replace(scene, bodies=bodies)
     if coarse:
         scene = dataclasses.replace(scene, mesh=dataclasses.replace(
             scene.mesh, parameters={"h_indenter": 0.08, "h_block": 0.12}))
@@ -118,9 +122,12 @@ def main() -> None:
     parser.add_argument("--coarse", action="store_true", help="h_indenter 0.08, h_block 0.12")
     parser.add_argument("--out", type=Path, default=harness.OUT)
     parser.add_argument("--picture", type=Path, default=None)
+    parser.add_argument("--indenter-E", type=float, default=None,
+                        help="the indenter's Young's modulus (default the scene's, 1000; "
+                        "100 makes the bodies alike: Dundurs beta = 0)")
     args = parser.parse_args()
-    friction = run(0.3, args.coarse)
-    plain = run(None, args.coarse)
+    friction = run(0.3, args.coarse, args.indenter_E)
+    plain = run(None, args.coarse, args.indenter_E)
     mu = 0.3
     for row, ref in zip(friction["rows"], plain["rows"], strict=False):
         row["ploughing_ratio"] = ref["reaction_ratio"]
@@ -145,7 +152,8 @@ def main() -> None:
     tails = [r["order"] for r in slide if not math.isnan(r["order"])]
     tails0 = [r["order"] for r in plain["rows"][len(press):] if not math.isnan(r["order"])]
     summary = {
-        "mu": mu, "coarse": args.coarse, "status": friction["status"],
+        "mu": mu, "coarse": args.coarse, "indenter_E": args.indenter_E,
+        "status": friction["status"],
         "status_frictionless": plain["status"],
         "steady_window_slide_over_R": STEADY, "steady_steps": len(steady),
         "reaction_ratio": span("reaction_ratio"), "ploughing_ratio": span("ploughing_ratio"),
@@ -198,7 +206,8 @@ def main() -> None:
          ["max penetration / R", summary["max_penetration_over_R"]]],
     )
     text = f"# Ironing with friction (mu = {mu}, GNRM)\n\n{table}\n"
-    name = "ironing_friction" + ("_coarse" if args.coarse else "")
+    name = ("ironing_friction" + ("_coarse" if args.coarse else "")
+            + (f"_E{args.indenter_E:g}" if args.indenter_E is not None else ""))
     harness.write(name, {"machine": harness.machine(), "summary": summary,
                          "friction": friction, "frictionless": plain}, text, args.out)
     with open(args.out / f"{name}.csv", "w", newline="") as handle:

@@ -19,8 +19,8 @@ from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.friction import SLIP, STICK
 from fenics_contact.model.materials import material
 from fenics_contact.model.pair_friction import FrictionalTwoBodyProblem
-from fenics_contact.model.pairs import Body, PathDisplacement, TwoBodyProblem
-from fenics_contact.model.problem import PrescribedDisplacement
+from fenics_contact.model.pairs import Body, TwoBodyProblem
+from fenics_contact.model.problem import PathDisplacement, PrescribedDisplacement
 from fenics_contact.scene import two_body_meshing as tbm
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings

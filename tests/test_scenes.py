@@ -129,3 +129,28 @@ def test_unknown_geo_parameter_is_named(tmp_path):
     scene_file.write_text(text.replace("h_contact = 0.004", "h_contct = 0.004"))
     with pytest.raises(SceneError, match=r"no parameter 'h_contct'.*h_contact"):
         build_mesh(load_scene(scene_file))
+
+
+def test_dirichlet_path_drives_a_one_body_scene(tmp_path):
+    """A [[dirichlet]] path is followed knot by knot, not ramped to its end value."""
+    import numpy as np
+    from dolfinx import fem
+
+    from fenics_contact.scene.build import build_problem
+
+    text = (SCENES / "hertz_cylinder.toml").read_text().replace(
+        "value = [0.0, -0.01]", "path = [[0.0, 0.0, 0.0], [0.5, 0.002, -0.01], [1.0, 0.0, -0.01]]"
+    )
+    scene = load_scene(write(tmp_path, text.replace('"../meshes/', f'"{SCENES.parent}/meshes/')))
+    problem = build_problem(scene)
+    for t, expected in ((0.25, (0.001, -0.005)), (0.5, (0.002, -0.01)), (0.75, (0.001, -0.01))):
+        problem.set_load(t)
+        u = fem.Function(problem.V)
+        u.x.array[:] = np.nan
+        for bc in problem.bcs:
+            bc.set(u.x.array)
+        values = u.x.array.reshape(-1, 2)
+        for i in range(2):
+            prescribed = values[~np.isnan(values[:, i]), i]
+            assert prescribed.size > 0
+            assert np.allclose(prescribed, expected[i], atol=1e-15), (t, i)

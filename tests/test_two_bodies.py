@@ -201,7 +201,7 @@ def _order(residuals: list[float], floor: float = 1e-11) -> float:
 
 def test_ironing_short() -> None:
     """Press, then slide 1.2 radii in 8 steps (coarse mesh): GNRM converges, no penetration."""
-    from fenics_contact.model.pairs import PathDisplacement
+    from fenics_contact.model.problem import PathDisplacement
 
     md = tbm.ironing(MPI.COMM_WORLD, h_indenter=0.08, h_block=0.12)
     ft = md.facet_tags

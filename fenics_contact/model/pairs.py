@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import ufl
-from dolfinx import default_scalar_type, fem, la, mesh
+from dolfinx import fem, la, mesh
 
 from mpi4py import MPI
 
@@ -44,7 +44,6 @@ from fenics_contact.model.problem import (
     ContactState,
     PrescribedDisplacement,
     SurfaceTraction,
-    _facet_tags,
     energy_quadrature_degree,
 )
 from fenics_contact.model.search import SurfaceSearch
@@ -63,24 +62,6 @@ class Body:
     name: str
     tag: int
     material: Elastic
-
-
-@dataclass(frozen=True)
-class PathDisplacement(PrescribedDisplacement):
-    """A prescribed displacement along a piecewise-linear path in the load factor.
-
-    Attributes:
-        path: knots (t, u_1, ..., u_d), t increasing from 0 to 1 (length units);
-            ``value`` (the end point) is unused.
-    """
-
-    path: tuple[tuple[float, ...], ...] = ()
-
-    def at(self, t: float) -> np.ndarray:
-        """Displacement at load factor t (linear between knots)."""
-        knots = np.asarray(self.path, float)
-        return np.array([np.interp(t, knots[:, 0], knots[:, 1 + i])
-                         for i in range(knots.shape[1] - 1)])
 
 
 def _node_to_block(V: fem.FunctionSpace) -> np.ndarray:
@@ -370,31 +351,9 @@ class TwoBodyProblem(ContactProblem):
         self.pair_modulus = 2.0 * Es * Et / (Es + Et)
         self.material = s_body.material
         self.obstacle = None
-        self.settings = settings
-        self.V = fem.functionspace(domain, ("Lagrange", degree, (gdim,)))
-        self.u = fem.Function(self.V, name="displacement")
-        self.facet_tags = _facet_tags(domain, striker_facets, tractions)
-        self.surface = ContactSurface(
-            domain, striker_facets, settings.quadrature, tags=self.facet_tags
-        )
-        self.Q = self.surface.Q
-        self.lam = fem.Function(self.Q, name="contact_pressure")
-        self.r = fem.Constant(domain, default_scalar_type(1.0))
-        self.set_r(settings.r, relative=settings.relative)
-        self.load_factor = 0.0
+        self._unknowns(settings, striker_facets, tractions, degree)
         self._motion = np.zeros(gdim)
-        self._bc_constants = []
-        self._path_constants: list[tuple[fem.Constant, PathDisplacement, int]] = []
-        fixed = [c for c in prescribed if not isinstance(c, PathDisplacement)]
-        self.bcs = self._dirichlet(fixed)
-        for c in prescribed:
-            if isinstance(c, PathDisplacement):
-                for i in range(gdim):
-                    Vi = self.V.sub(i)
-                    dofs = fem.locate_dofs_topological(Vi, gdim - 1, c.facets)
-                    const = fem.Constant(domain, default_scalar_type(0.0))
-                    self._path_constants.append((const, c, i))
-                    self.bcs.append(fem.dirichletbc(const, dofs, Vi))
+        self.bcs = self._dirichlet(prescribed)
         self._traction_constants = []
         external = self._external_work(tractions)
 
@@ -456,12 +415,9 @@ class TwoBodyProblem(ContactProblem):
     def set_load(self, t: float) -> None:
         """Apply the load factor t to the prescribed values and tractions."""
         self.load_factor = float(t)
-        for const, value in self._bc_constants:
-            const.value = t * value
+        self._apply_prescribed(t)
         for const, value in self._traction_constants:
             const.value[:] = t * value
-        for const, condition, i in self._path_constants:
-            const.value = condition.at(t)[i]
 
     def reaction(self, facets: np.ndarray) -> np.ndarray:
         """Internal nodal force summed over the facets' nodes, per component (force).

@@ -45,6 +45,28 @@ class PrescribedDisplacement:
     facets: np.ndarray
     value: tuple[float | None, ...]
 
+    def at(self, t: float) -> tuple[float | None, ...]:
+        """Displacement per component at load factor t (None: free)."""
+        return tuple(None if v is None else t * float(v) for v in self.value)
+
+
+@dataclass(frozen=True)
+class PathDisplacement(PrescribedDisplacement):
+    """A prescribed displacement along a piecewise-linear path in the load factor.
+
+    Attributes:
+        path: knots (t, u_1, ..., u_d), t increasing from 0 to 1 (length units);
+            every component is prescribed and ``value`` (the end point) is unused.
+    """
+
+    path: tuple[tuple[float, ...], ...] = ()
+
+    def at(self, t: float) -> tuple[float | None, ...]:
+        """Displacement at load factor t (linear between knots)."""
+        knots = np.asarray(self.path, float)
+        return tuple(float(np.interp(t, knots[:, 0], knots[:, 1 + i]))
+                     for i in range(knots.shape[1] - 1))
+
 
 @dataclass(frozen=True)
 class SurfaceTraction:
@@ -238,7 +260,7 @@ class ProblemBase:
     lam: fem.Function
     r: fem.Constant
     load_factor: float
-    _bc_constants: list[tuple[fem.Constant, float]]
+    _bc_constants: list[tuple[fem.Constant, PrescribedDisplacement, int]]
 
     @property
     def stiffness_scale(self) -> float:
@@ -268,23 +290,31 @@ class ProblemBase:
         return self.r_absolute / self.stiffness_scale
 
     def _dirichlet(self, prescribed: Sequence[PrescribedDisplacement]) -> list[fem.DirichletBC]:
+        """One Dirichlet condition per prescribed component, valued by :meth:`_apply_prescribed`."""
         fdim = self.domain.topology.dim - 1
+        self._bc_constants = []
         bcs = []
         for condition in prescribed:
-            if len(condition.value) != self.domain.geometry.dim:
+            components = condition.at(1.0)
+            if len(components) != self.domain.geometry.dim:
                 raise ValueError(
                     f"Prescribed displacement {condition.value} needs one entry per "
                     f"component ({self.domain.geometry.dim}); use None for a free one."
                 )
-            for i, value in enumerate(condition.value):
+            for i, value in enumerate(components):
                 if value is None:
                     continue
                 Vi = self.V.sub(i)
                 dofs = fem.locate_dofs_topological(Vi, fdim, condition.facets)
                 const = fem.Constant(self.domain, default_scalar_type(0.0))
-                self._bc_constants.append((const, float(value)))
+                self._bc_constants.append((const, condition, i))
                 bcs.append(fem.dirichletbc(const, dofs, Vi))
         return bcs
+
+    def _apply_prescribed(self, t: float) -> None:
+        """Set every prescribed component to its value at load factor t."""
+        for const, condition, i in self._bc_constants:
+            const.value = condition.at(t)[i]
 
     def min_det_F(self) -> DetFMinimum:
         """Smallest det F over the body (quadrature points of degree 2, all ranks).
@@ -367,24 +397,12 @@ class ContactProblem(ProblemBase):
         self.comm = domain.comm
         self.material = material
         self.obstacle = obstacle
-        self.settings = settings
-        self.V = fem.functionspace(domain, ("Lagrange", degree, (gdim,)))
-        self.u = fem.Function(self.V, name="displacement")
-        self.facet_tags = _facet_tags(domain, contact_facets, tractions)
-        self.surface = ContactSurface(
-            domain, contact_facets, settings.quadrature, tags=self.facet_tags
-        )
-        self.Q = self.surface.Q
-        self.lam = fem.Function(self.Q, name="contact_pressure")
-        self.r = fem.Constant(domain, default_scalar_type(1.0))
-        self.set_r(settings.r, relative=settings.relative)
-        self.load_factor = 0.0
+        self._unknowns(settings, contact_facets, tractions, degree)
 
         self._motion = (
             np.zeros(gdim) if obstacle_motion is None else np.asarray(obstacle_motion, float)
         )
         self._schedule = _schedule(obstacle_schedule, gdim)
-        self._bc_constants: list[tuple[fem.Constant, float]] = []
         self.bcs = self._dirichlet(prescribed)
         self._traction_constants: list[tuple[fem.Constant, np.ndarray]] = []
         external = self._external_work(tractions)
@@ -419,8 +437,7 @@ class ContactProblem(ProblemBase):
     def set_load(self, t: float) -> None:
         """Apply the load factor t: prescribed values, tractions and obstacle motion."""
         self.load_factor = float(t)
-        for const, value in self._bc_constants:
-            const.value = t * value
+        self._apply_prescribed(t)
         for const, value in self._traction_constants:
             const.value[:] = t * value
         self.obstacle.translate_to(self.obstacle_offset(t))
@@ -434,6 +451,28 @@ class ContactProblem(ProblemBase):
 
     def refresh_search(self) -> None:
         """Bring data that follow u up to date (two bodies: the search); none here."""
+
+    def _unknowns(
+        self,
+        settings: ContactSettings,
+        contact_facets: np.ndarray,
+        tractions: Sequence[SurfaceTraction],
+        degree: int,
+    ) -> None:
+        """Displacement space and u, the contact submesh with lam, and r (load factor 0)."""
+        domain = self.domain
+        self.settings = settings
+        self.V = fem.functionspace(domain, ("Lagrange", degree, (domain.geometry.dim,)))
+        self.u = fem.Function(self.V, name="displacement")
+        self.facet_tags = _facet_tags(domain, contact_facets, tractions)
+        self.surface = ContactSurface(
+            domain, contact_facets, settings.quadrature, tags=self.facet_tags
+        )
+        self.Q = self.surface.Q
+        self.lam = fem.Function(self.Q, name="contact_pressure")
+        self.r = fem.Constant(domain, default_scalar_type(1.0))
+        self.set_r(settings.r, relative=settings.relative)
+        self.load_factor = 0.0
 
     def _external_work(self, tractions: Sequence[SurfaceTraction]) -> ufl.Form | None:
         if not tractions:

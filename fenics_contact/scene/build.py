@@ -20,7 +20,12 @@ from mpi4py import MPI
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import material
 from fenics_contact.model.obstacles import RigidBall, RigidObstacle, RigidPlane
-from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement, SurfaceTraction
+from fenics_contact.model.problem import (
+    ContactProblem,
+    PathDisplacement,
+    PrescribedDisplacement,
+    SurfaceTraction,
+)
 from fenics_contact.model.rigid import free_rigid_motions
 
 if TYPE_CHECKING:
@@ -214,15 +219,45 @@ def contact_facets(scene: Scene, body: BodyMesh, obstacle: RigidObstacle) -> np.
     from fenics_contact.model.candidates import detect_candidate_facets
 
     pushes = [abs(v) for d in scene.dirichlet for v in d.value if v is not None]
+    pushes += [abs(v) for d in scene.dirichlet for knot in d.path for v in knot[1:]]
     return detect_candidate_facets(
         body.domain, obstacle, scene.obstacle.motion, spec.margin,
         displacement_bound=max(pushes, default=0.0),
     )
 
 
+def boundary_conditions(
+    scene: Scene, body: BodyMesh
+) -> tuple[list[PrescribedDisplacement], list[SurfaceTraction]]:
+    """The scene's [[dirichlet]] (values or load paths) and [[traction]] conditions on ``body``.
+
+    Raises SceneError for a condition whose tag and bounds select no facet.
+    """
+    comm = body.domain.comm
+    prescribed: list[PrescribedDisplacement] = []
+    for i, spec in enumerate(scene.dirichlet):
+        facets = _restricted(body, tagged_facets(body, scene, f"dirichlet {i + 1}", spec.tag), spec)
+        if comm.allreduce(facets.size, op=MPI.SUM) == 0:
+            raise SceneError(
+                f"{scene.path.name}: [[dirichlet]] {i + 1} selects no facet; widen its bounds."
+            )
+        prescribed.append(
+            PathDisplacement(facets, spec.value, path=spec.path) if spec.path
+            else PrescribedDisplacement(facets, spec.value)
+        )
+    tractions = [
+        SurfaceTraction(
+            _restricted(body, tagged_facets(body, scene, f"traction {i + 1}", spec.tag), spec),
+            tuple(float(v) for v in spec.value if v is not None),
+        )
+        for i, spec in enumerate(scene.tractions)
+    ]
+    return prescribed, tractions
+
+
 def build_two_body_problem(scene: Scene, body: BodyMesh) -> TwoBodyProblem:
     """Bodies, conditions and the contact pair of a two-body scene (with [[pair]] mu: friction)."""
-    from fenics_contact.model.pairs import Body, PathDisplacement, TwoBodyProblem
+    from fenics_contact.model.pairs import Body, TwoBodyProblem
 
     comm = body.domain.comm
     if body.cell_tags is None:
@@ -242,20 +277,7 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> TwoBodyProblem:
             )
         bodies.append(Body(spec.name, tag, material(spec.law, spec.E, spec.nu)))
     pair = scene.pairs[0]
-    prescribed = []
-    for i, spec in enumerate(scene.dirichlet):
-        facets = _restricted(body, tagged_facets(body, scene, f"dirichlet {i + 1}", spec.tag), spec)
-        if spec.path:
-            prescribed.append(PathDisplacement(facets, spec.value, path=spec.path))
-        else:
-            prescribed.append(PrescribedDisplacement(facets, spec.value))
-    tractions = [
-        SurfaceTraction(
-            _restricted(body, tagged_facets(body, scene, f"traction {i + 1}", spec.tag), spec),
-            tuple(float(v) for v in spec.value if v is not None),
-        )
-        for i, spec in enumerate(scene.tractions)
-    ]
+    prescribed, tractions = boundary_conditions(scene, body)
     args = (
         body.domain, body.cell_tags, bodies,
         tagged_facets(body, scene, "pair striker", pair.striker),
@@ -277,32 +299,12 @@ def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProbl
     body = build_mesh(scene, comm)
     if scene.two_body:
         return build_two_body_problem(scene, body)
-    for i, spec in enumerate(scene.dirichlet):
-        if spec.path:
-            raise SceneError(
-                f"{scene.path.name}: [[dirichlet]] {i + 1} path: load paths need a two-body "
-                "scene; give 'value' (proportional loading) instead."
-            )
     if body.domain.geometry.dim != scene.dimension:
         raise SceneError(
             f"{scene.path.name}: [scene] dimension = {scene.dimension} but the mesh is "
             f"{body.domain.geometry.dim}D."
         )
-    prescribed = []
-    for i, spec in enumerate(scene.dirichlet):
-        facets = _restricted(body, tagged_facets(body, scene, f"dirichlet {i + 1}", spec.tag), spec)
-        if comm.allreduce(facets.size, op=MPI.SUM) == 0:
-            raise SceneError(
-                f"{scene.path.name}: [[dirichlet]] {i + 1} selects no facet; widen its bounds."
-            )
-        prescribed.append(PrescribedDisplacement(facets, spec.value))
-    tractions = [
-        SurfaceTraction(
-            _restricted(body, tagged_facets(body, scene, f"traction {i + 1}", spec.tag), spec),
-            tuple(float(v) for v in spec.value if v is not None),
-        )
-        for i, spec in enumerate(scene.tractions)
-    ]
+    prescribed, tractions = boundary_conditions(scene, body)
     check_rigid_motions(scene, body, prescribed)
     obstacle = build_obstacle(scene, body.domain)
     settings = ContactSettings(

@@ -189,7 +189,6 @@ class StrikerOnFacetProblem(ProblemBase):
         self.set_r(settings.r, relative=settings.relative)
         self.load_factor = 0.0
         self.striker = fem.Constant(domain, self._start.copy())
-        self._bc_constants: list[tuple[fem.Constant, float]] = []
         self.bcs = self._dirichlet(prescribed)
 
         # the gap at the striker, from u on the target facet
@@ -235,8 +234,7 @@ class StrikerOnFacetProblem(ProblemBase):
         """Move the striker to start + t motion and scale the prescribed values."""
         self.load_factor = float(t)
         self.striker.value[:] = self._start + t * self._motion
-        for const, value in self._bc_constants:
-            const.value = t * value
+        self._apply_prescribed(t)
 
     # -- systems handed to solvers -------------------------------------------
     def _lagrangian(self) -> ufl.Form:

@@ -118,7 +118,7 @@ class IroningShort:
 
     def build(self, settings: ContactSettings, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyProblem:
         """Mesh indenter and block and create the problem."""
-        from fenics_contact.model.pairs import PathDisplacement
+        from fenics_contact.model.problem import PathDisplacement
 
         md = tbm.ironing(comm, h_indenter=0.08, h_block=0.12)
         ft = md.facet_tags
