@@ -374,11 +374,7 @@ class TwoBodyProblem(ContactProblem):
         self.potential = potential
         if external is not None:
             self.potential -= external
-        self._gap_form = self.surface.nodal_form(self.gap)
-        self._pressure_form = self.surface.nodal_form(self.pressure)
-        self._force_form = fem.form(
-            -self.pressure * self.surface.ds, entity_maps=self.surface.entity_maps
-        )
+        self._diagnostic_forms()
         self.pair.refresh()
 
     @staticmethod

@@ -419,14 +419,7 @@ class ContactProblem(ProblemBase):
         if external is not None:
             self.potential -= external
 
-        self._gap_form = self.surface.nodal_form(self.gap)
-        self._pressure_form = self.surface.nodal_form(self.pressure)
-        self._force_form = fem.form(
-            -self.pressure * self.surface.ds, entity_maps=self.surface.entity_maps
-        )
-        self._multiplier_force_form = fem.form(
-            -self.lam * self.surface.ds, entity_maps=self.surface.entity_maps
-        )
+        self._diagnostic_forms()
 
     # -- parameters and loads -------------------------------------------------
     @property
@@ -473,6 +466,17 @@ class ContactProblem(ProblemBase):
         self.r = fem.Constant(domain, default_scalar_type(1.0))
         self.set_r(settings.r, relative=settings.relative)
         self.load_factor = 0.0
+
+    def _diagnostic_forms(self) -> None:
+        """Nodal gap and pressure, and the normal contact force by p_n and by lam."""
+        self._gap_form = self.surface.nodal_form(self.gap)
+        self._pressure_form = self.surface.nodal_form(self.pressure)
+        self._force_form = fem.form(
+            -self.pressure * self.surface.ds, entity_maps=self.surface.entity_maps
+        )
+        self._multiplier_force_form = fem.form(
+            -self.lam * self.surface.ds, entity_maps=self.surface.entity_maps
+        )
 
     def _external_work(self, tractions: Sequence[SurfaceTraction]) -> ufl.Form | None:
         if not tractions:
