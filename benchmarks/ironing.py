@@ -28,7 +28,6 @@ import fenics_contact  # noqa: F401  (before dolfinx)
 from fenics_contact.scene.build import build_mesh, build_two_body_problem, tagged_facets
 from fenics_contact.scene.schema import load_scene
 from fenics_contact.solvers import make_strategy
-from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.predictor import Extrapolated
 from fenics_contact.solvers.stepping import solve_load_path
 
@@ -57,9 +56,7 @@ def main() -> None:
     path_spec = next(d for d in scene.dirichlet if d.path)
     knots = np.asarray(path_spec.path)
     radius = 0.5
-    strategy = make_strategy(scene.solver.method, problem, SolverSettings(
-        atol=scene.solver.atol, rtol=scene.solver.rtol,
-        max_iterations=scene.solver.max_iterations))
+    strategy = make_strategy(scene.solver.method, problem, scene.solver)
     if scene.solver.predictor == "extrapolate":
         strategy = Extrapolated(strategy)
     rows: list[dict] = []

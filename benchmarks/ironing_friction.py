@@ -51,7 +51,6 @@ import fenics_contact  # noqa: F401  (before dolfinx)
 from fenics_contact.scene.build import build_mesh, build_two_body_problem, tagged_facets
 from fenics_contact.scene.schema import load_scene
 from fenics_contact.solvers import make_strategy
-from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.predictor import Extrapolated
 from fenics_contact.solvers.stepping import solve_load_path
 
@@ -80,9 +79,7 @@ def run(mu: float | None, coarse: bool, indenter_E: float | None = None) -> dict
     problem = build_two_body_problem(scene, body)
     top = tagged_facets(body, scene, "top", "top")
     knots = np.asarray(next(d for d in scene.dirichlet if d.path).path)
-    settings = SolverSettings(atol=scene.solver.atol, rtol=scene.solver.rtol,
-                              max_iterations=scene.solver.max_iterations)
-    strategy = make_strategy(scene.solver.method, problem, settings)
+    strategy = make_strategy(scene.solver.method, problem, scene.solver)
     if scene.solver.predictor == "extrapolate":
         strategy = Extrapolated(strategy)
     rows: list[dict] = []

@@ -16,7 +16,6 @@ from fenics_contact.scene.build import build_problem
 from fenics_contact.scene.schema import Scene
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.base import SolveResult
-from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.predictor import Extrapolated
 from fenics_contact.solvers.stepping import RunRecord, StepRecord, solve_load_path, start_record
@@ -91,12 +90,8 @@ def run_scene(
     run_identity = identity(scene, comm.size)
     marker = read_latest(out / "checkpoint", run_identity) if resume else None  # before building
     problem = build_problem(scene, comm)
-    settings = SolverSettings(
-        atol=scene.solver.atol, rtol=scene.solver.rtol,
-        max_iterations=scene.solver.max_iterations,
-    )
     strategy = make_strategy(
-        scene.solver.method, problem, settings,
+        scene.solver.method, problem, scene.solver,  # a SolverSettings with stepping keys
         linear=LinearSolverSettings(kind=scene.solver.linear_solver),
         observer=on_residual, predictor=scene.solver.predictor,
     )

@@ -307,16 +307,12 @@ def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProbl
     prescribed, tractions = boundary_conditions(scene, body)
     check_rigid_motions(scene, body, prescribed)
     obstacle = build_obstacle(scene, body.domain)
-    settings = ContactSettings(
-        r=scene.contact.r, relative=scene.contact.relative,
-        quadrature=scene.contact.quadrature,  # type: ignore[arg-type]
-    )
     args = (
         body.domain,
         material(scene.law, scene.E, scene.nu),
         obstacle,
         contact_facets(scene, body, obstacle),
-        settings,
+        scene.contact,  # a ContactSettings with the candidate and friction keys
     )
     options: dict[str, Any] = {
         "prescribed": prescribed,

@@ -59,9 +59,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fenics_contact.model.contact import r_problem
+from fenics_contact.model.contact import ContactSettings, r_problem
 from fenics_contact.model.materials import MATERIALS, elastic_constants_problem
 from fenics_contact.solvers import STRATEGIES
+from fenics_contact.solvers.diagnostics import SolverSettings
 
 #: Method names a scene may give: the strategy registry's.
 METHODS = tuple(STRATEGIES)
@@ -163,28 +164,29 @@ class ObstacleSpec:
 
 
 @dataclass(frozen=True)
-class ContactSpec:
-    """Where contact may happen and how it is regularised."""
+class ContactSpec(ContactSettings):
+    """Where contact may happen, and how it is regularised (r, relative, quadrature).
+
+    The settings the contact term takes (:class:`ContactSettings`) plus the
+    candidate facets (a tag, or detection along the obstacle's path within
+    ``margin``) and Coulomb friction (``mu``, None frictionless; the cap of
+    r_t, ``tangential_r_max`` E/L).
+    """
 
     tag: int | str | None = None
     detect: bool = False
     margin: float = 0.0
-    r: float = 1.0
-    relative: bool = True
-    quadrature: str = "nodal"
     mu: float | None = None
     tangential_r_max: float | None = 2.0
 
 
 @dataclass(frozen=True)
-class SolverSpec:
-    """Strategy and load stepping."""
+class SolverSpec(SolverSettings):
+    """Stopping rules (:class:`SolverSettings`) plus strategy and load stepping."""
 
+    rtol: float = 1e-10
     method: str = "gnrm"
     steps: int = 10
-    max_iterations: int = 50
-    atol: float = 1e-8
-    rtol: float = 1e-10
     max_cutbacks: int = 4
     predictor: str = "extrapolate"
     linear_solver: str = "direct"
