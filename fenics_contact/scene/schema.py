@@ -42,7 +42,10 @@ Two deformable bodies in one mesh replace [material], [obstacle] and
     [[body]]     name, tag (cell tag), law, E, nu      (one per body)
     [[pair]]     striker, target (facet tags), r, relative,
                  mu, tangential_r_max (Coulomb friction, as in [contact])
-    [[dirichlet]] may give path = [[t, ux, uy], ...] instead of value
+
+In every scene a [[dirichlet]] may give path = [[t, ux, uy], ...] (a
+piecewise-linear displacement against the load factor, every component
+prescribed) instead of value.
 
 Generated meshes tag their sides: rectangle left = 1, right = 2,
 bottom = 3, top = 4; box xmin = 1, xmax = 2, ymin = 3, ymax = 4, zmin = 5,
@@ -117,7 +120,7 @@ class BoundarySpec:
     """A Dirichlet or traction condition on tagged facets (value at load factor 1).
 
     ``path``: optional knots (t, value...) of a piecewise-linear load path
-    (Dirichlet only; two-body scenes), from t = 0 to t = 1.
+    (Dirichlet only), from t = 0 to t = 1.
     """
 
     tag: int | str
