@@ -204,3 +204,33 @@ def test_signorini_test_names_penetration_and_tension_in_their_units():
         ContactSettings(r=1.0, quadrature="gauss"),
     )
     assert signorini_admissibility(gauss, SolverSettings()) is None
+
+
+def test_prescribed_displacements_must_hold_at_convergence():
+    """Two cylinders at r = 1e12 E/h: the round-off floor of the stopping test (0.4 of a
+    contact force 0.6) let penalty and GNRM stop before the first Newton step of every
+    load step, with the push not applied (u = 0, "converged", 0 iterations).
+
+    The Dirichlet rows hold x - x_D (length), so the residual norm alone cannot tell.
+    """
+    from fenics_contact.solvers.diagnostics import prescribed_admissibility
+    from fenics_contact.studies.stability import StabilityCase, run_case
+    from fenics_contact.verification.two_body_examples import TwoCylinders
+
+    scene = TwoCylinders()
+    problem = scene.build(ContactSettings(r=1.0))
+    check = prescribed_admissibility(problem, SolverSettings())
+    assert check() is None and problem.prescribed_mismatch() == 0.0
+    problem.set_load(0.5)  # push 0.02: the top is 0.01 from its prescribed value
+    assert problem.prescribed_mismatch() == pytest.approx(0.01, rel=1e-12)
+    assert check().startswith("prescribed displacement mismatch 0.01 > gap_tol * h")
+    run = solve_load_path(make_strategy("gnrm", problem, SolverSettings(atol=1e-8)), 1)
+    assert run.converged and problem.prescribed_mismatch() < 1e-15 and check() is None
+
+    case = StabilityCase("two-cyl-r1e12", "two-body-r", scene, 1e12)
+    for method in ("penalty", "gnrm"):
+        record = run_case(case, method)
+        # measured: diverged at the first iteration of step 1 (formerly converged, 0 iterations)
+        assert record.status != "converged" and record.iterations >= 1, (method, record.status)
+    auto = run_case(case, "auto")
+    assert auto.converged and auto.max_abs_u == pytest.approx(scene.push, rel=1e-12)

@@ -19,17 +19,18 @@ from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.friction import SLIP, STICK
 from fenics_contact.model.materials import material
 from fenics_contact.model.pair_friction import FrictionalTwoBodyProblem
-from fenics_contact.model.pairs import Body, TwoBodyProblem
+from fenics_contact.model.pairs import Body
 from fenics_contact.model.problem import PathDisplacement, PrescribedDisplacement
 from fenics_contact.scene import two_body_meshing as tbm
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.stepping import solve_load_path
+from fenics_contact.verification.two_body_examples import PRESS_SLIDE_PAIR, SlidingBlocks
 
 MU = 0.3
 STEPS = 10
 #: Press 0.01 over load factors 0 ... 0.4 (4 steps), then slide 0.04.
-PATH = ((0.0, 0.0, 0.0), (0.4, 0.0, -0.01), (1.0, 0.04, -0.01))
+PATH = PRESS_SLIDE_PAIR
 PRESS_STEPS = 4
 #: Serial reference (GNRM, r = 1 E/h, r_t = 2 E/L): iterations per step and final forces.
 SERIAL_ITERATIONS = [4, 2, 3, 2, 2, 4, 4, 4, 4, 4]
@@ -38,20 +39,10 @@ SERIAL_TANGENTIAL_FORCE = 0.4773198325213958
 
 
 def blocks(mu: float | None = MU, r: float = 1.0):
-    """The sliding blocks; ``mu = None`` gives the frictionless TwoBodyProblem."""
-    md = tbm.block_on_block(MPI.COMM_WORLD, n_upper=6, n_lower=9, upper_width=0.6)
-    ft = md.facet_tags
-    law = material("linear", 200.0, 0.3)
-    args = (md.mesh, md.cell_tags,
-            [Body("upper", tbm.STRIKER_TAG, law), Body("lower", tbm.TARGET_TAG, law)],
-            ft.find(tbm.STRIKER_FACE_TAG), ft.find(tbm.TARGET_FACE_TAG), ContactSettings(r=r))
-    options = {"prescribed": [
-        PrescribedDisplacement(ft.find(tbm.SUPPORT_TAG), (0.0, 0.0)),
-        PathDisplacement(ft.find(tbm.LOAD_TAG), (None, None), path=PATH),
-    ]}
-    if mu is None:
-        return TwoBodyProblem(*args, **options), ft
-    return FrictionalTwoBodyProblem(*args, mu=mu, **options), ft
+    """The sliding blocks and their facet tags; ``mu = None``: the frictionless TwoBodyProblem."""
+    scene = SlidingBlocks(mu=mu, path=PATH)
+    md = scene.mesh()
+    return scene.problem(md, ContactSettings(r=r)), md.facet_tags
 
 
 def solve(method: str = "gnrm", r: float = 1.0, mu: float | None = MU, max_iterations=50):

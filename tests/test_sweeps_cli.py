@@ -3,6 +3,8 @@
 import csv
 import json
 
+import pytest
+
 from fenics_contact.cli import main
 
 
@@ -68,3 +70,31 @@ def test_tradeoff_friction_group_scores_the_coulomb_law(tmp_path):
     table = (tmp_path / "table.md").read_text()
     assert "| slide | 10x5 | 0.3 | GNRM | 1 - 10000 |" in table
     assert (tmp_path / "tradeoff.png").stat().st_size > 10_000
+
+
+def test_stability_two_body_friction_records_coulomb_ratio_and_reference(tmp_path, capsys):
+    """Sliding blocks with friction: F_t / (mu N) and the reference (GNRM at r = 1 E/h).
+
+    At r = 1e12 E/h auto "converges" off the reference: the pressure carries a
+    round-off of eps r g (about 15 % of p), so F_t = 1.013 mu N (measured).
+    """
+    with pytest.raises(SystemExit):
+        main(["stability", "--help"])
+    assert "friction-r,two-body-friction,two-body-friction-r)" in "".join(
+        capsys.readouterr().out.split())
+    code = main(["stability", "--cases", "blocks-mu0.3,blocks-r1e12", "--methods", "gnrm,auto",
+                 "--out", str(tmp_path)])
+    assert code == 0
+    rows = {(r["case"], r["method"]): r for r in read_csv(tmp_path / "stability.csv")}
+    assert {"mu", "tangential_force", "ft_ratio", "reference", "reference_deviation",
+            "reference_reached"} <= set(rows[("blocks-mu0.3", "gnrm")])
+    for method in ("gnrm", "auto"):  # the reference itself; full slip: F_t = mu N (tilted facets)
+        row = rows[("blocks-mu0.3", method)]
+        assert row["status"] == "converged" and float(row["mu"]) == 0.3
+        assert float(row["ft_ratio"]) == pytest.approx(0.99998, abs=1e-5)
+        assert row["reference"] == "gnrm r=1" and row["reference_reached"] == "True"
+        assert float(row["reference_deviation"]) < 1e-12
+    gnrm, auto = rows[("blocks-r1e12", "gnrm")], rows[("blocks-r1e12", "auto")]
+    assert gnrm["status"] == "diverged" and gnrm["reference_reached"] == "False"
+    assert auto["status"] == "converged" and auto["reference_reached"] == "False"
+    assert 1e-3 < float(auto["reference_deviation"]) < 1e-2 and float(auto["ft_ratio"]) > 1.005

@@ -28,6 +28,9 @@ def _stability(args: argparse.Namespace) -> int:
             print(
                 f"  {rec.case:20s} {rec.method:8s} {rec.status:15s} it {rec.iterations:5d} "
                 f"steps {rec.steps_completed}/{rec.load_steps}  {rec.wall_s:6.2f} s"
+                + ("" if rec.ft_ratio is None else f"  Ft/muN {rec.ft_ratio:.6f}")
+                + ("" if rec.reference_reached is None
+                   else "  reference " + ("reached" if rec.reference_reached else "missed"))
                 + (f"  {rec.message}" if rec.message else ""),
                 flush=True,
             )
@@ -69,14 +72,16 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Run methods on extreme cases (r 1e-8 ... 1e12 E/h, E 1e-3 ... 1e12, "
         "nu up to 0.4999, 1/10/100 load steps, initial penetration, grazing, no and full "
         "contact, coarse and fine meshes, two deformable bodies, Coulomb friction mu 0 ... 10, "
-        "r extremes and a load reversal with friction); write stability.csv, stability.json, "
-        "stability.png and per-run step records under cases/. Exit code 0, or 1 when a "
-        "run ended with an error (an exception, not a solver status).",
+        "r extremes and a load reversal with friction, on a rigid plane and between two "
+        "blocks); record each run's status, iterations, forces, F_t/(mu N) and whether it "
+        "reached the reference answer (GNRM at r = 1 E/h); write stability.csv, "
+        "stability.json, stability.png and per-run step records under cases/. Exit code 0, "
+        "or 1 when a run ended with an error (an exception, not a solver status).",
     )
     cmd.add_argument("--cases", type=_names, default=None,
                      help="comma-separated case names or groups (r, E, nu, steps, start, mesh, "
-                     "two-body-r, two-body-stiffness, two-body-sliding, friction, friction-r); "
-                     "default: all")
+                     "two-body-r, two-body-stiffness, two-body-sliding, friction, friction-r, "
+                     "two-body-friction, two-body-friction-r); default: all")
     cmd.add_argument("--methods", type=methods, default=list(METHODS),
                      help="comma-separated strategies (default penalty,sua,nua,gnrm,auto)")
     cmd.add_argument("--max-iterations", type=int, default=100,

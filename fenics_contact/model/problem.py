@@ -316,6 +316,20 @@ class ProblemBase:
         for const, condition, i in self._bc_constants:
             const.value = condition.at(t)[i]
 
+    def prescribed_mismatch(self) -> float:
+        """Largest |u - u_D| over the prescribed components at the current load factor (length).
+
+        Global over ranks. Zero once a Newton step has been taken at this load
+        factor (the Dirichlet rows are linear); the increment of the
+        prescribed values before the first step of a load step.
+        """
+        local = 0.0
+        for (const, _, _), bc in zip(self._bc_constants, self.bcs, strict=True):
+            dofs, n_owned = bc.dof_indices()
+            values = self.u.x.array[dofs[:n_owned]]
+            local = max(local, float(np.max(np.abs(values - float(const.value)), initial=0.0)))
+        return self.comm.allreduce(local, op=MPI.MAX)
+
     def min_det_F(self) -> DetFMinimum:
         """Smallest det F over the body (quadrature points of degree 2, all ranks).
 

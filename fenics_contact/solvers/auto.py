@@ -54,7 +54,9 @@ from fenics_contact.solvers.diagnostics import (
     ConvergenceMonitor,
     SolverSettings,
     Status,
+    all_of,
     contact_admissibility,
+    prescribed_admissibility,
 )
 from fenics_contact.solvers.newton import NewtonKernel
 
@@ -229,7 +231,8 @@ class AutoStrategy(NewtonStrategy):
         """Newton on the Alart-Curnier system, plain or with backtracking."""
         monitor = ConvergenceMonitor(
             settings, observer=self._progress(tally),
-            admissible=contact_admissibility(self.problem, settings),
+            admissible=all_of(prescribed_admissibility(self.problem, settings),
+                              contact_admissibility(self.problem, settings)),
         )
         if line_search:
             status, steps = self._line_search_loop(self.kernel, monitor)

@@ -13,7 +13,9 @@ from fenics_contact.solvers.diagnostics import (
     ConvergenceMonitor,
     SolverSettings,
     Status,
+    all_of,
     contact_admissibility,
+    prescribed_admissibility,
 )
 from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.newton import NewtonKernel
@@ -182,14 +184,17 @@ class NewtonStrategy:
     def monitor(self, settings: SolverSettings | None = None) -> ConvergenceMonitor:
         """A fresh convergence monitor reporting to the observer.
 
-        Unless the strategy regularises the constraint (penalty), converged
-        also needs the Signorini conditions in their own units.
+        Converged needs the prescribed displacements to hold and, unless the
+        strategy regularises the constraint (penalty), the Signorini (and
+        Coulomb) conditions in their own units.
         """
         settings = settings or self.settings
         return ConvergenceMonitor(
             settings, observer=self.observer,
-            admissible=contact_admissibility(self.problem, settings)
-            if self.exact_constraint else None,
+            admissible=all_of(
+                prescribed_admissibility(self.problem, settings),
+                contact_admissibility(self.problem, settings) if self.exact_constraint else None,
+            ),
         )
 
     def residual_norm(self) -> float:

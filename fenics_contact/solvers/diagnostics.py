@@ -13,7 +13,12 @@ Statuses, with their defined tests (checked in this order each iteration):
   r g hides a gap. With friction the Coulomb conditions are tested too
   (:func:`coulomb_admissibility`): no slip beyond ``gap_tol`` h at
   sticking nodes, tangential complementarity and Coulomb excess within
-  ``tension_tol`` E.
+  ``tension_tol`` E. For every strategy, penalty included, the prescribed
+  displacements must hold to ``gap_tol`` h (:func:`prescribed_admissibility`):
+  the Dirichlet rows of the residual hold x - x_D in length units, so at a
+  large r, whose round-off floor raises the tolerance, the residual before
+  the first Newton step of a displacement-driven step could pass the test
+  with the load not applied.
 - ``cycling``: over the last ``cycle_window`` iterations the residual never
   fell below the smallest value seen before that window, and the active set
   (or, without one, the rounded residual) returned to a state it had left
@@ -291,25 +296,49 @@ def coulomb_admissibility(
     return check
 
 
-def contact_admissibility(
+def prescribed_admissibility(
     problem, settings: SolverSettings
 ) -> Callable[[], str | None] | None:
-    """The Signorini test, followed by the Coulomb test for frictional problems.
+    """The prescribed displacements of a converged iterate: |u - u_D| <= gap_tol h.
 
-    None when neither applies (Gauss rule).
+    None when the problem prescribes no displacement.
     """
-    checks = [
-        c for c in (signorini_admissibility(problem, settings),
-                    coulomb_admissibility(problem, settings)) if c is not None
-    ]
-    if not checks:
+    if not getattr(problem, "bcs", None):
+        return None
+    h = float(problem.surface.h)
+
+    def check() -> str | None:
+        return _first_violation(
+            settings, h, 0.0, [("prescribed displacement mismatch", problem.prescribed_mismatch())],
+            [],
+        )
+
+    return check
+
+
+Check = Callable[[], str | None]
+
+
+def all_of(*checks: Check | None) -> Check | None:
+    """One check from several, in order: the first refusal (None when no check is given)."""
+    given = [c for c in checks if c is not None]
+    if not given:
         return None
 
     def check() -> str | None:
-        for c in checks:
+        for c in given:
             reason = c()
             if reason is not None:
                 return reason
         return None
 
     return check
+
+
+def contact_admissibility(problem, settings: SolverSettings) -> Check | None:
+    """The Signorini test, followed by the Coulomb test for frictional problems.
+
+    None when neither applies (Gauss rule).
+    """
+    return all_of(signorini_admissibility(problem, settings),
+                  coulomb_admissibility(problem, settings))

@@ -8,7 +8,16 @@ contact, full contact, a very coarse and a fine mesh; and the sliding block
 with Coulomb friction (groups ``friction``: mu from 0 to 10 and a load
 reversal at r = 1 E/h; ``friction-r``: r from 1e-8 to 1e12 E/h at mu = 0.3,
 with the default r_t = min(r, 2 E/L), L the contact surface extent, and with
-r_t = r).
+r_t = r); the sliding blocks pair with friction (``two-body-friction``: mu
+from 0 to 10 and a load reversal at r = 1 E/h; ``two-body-friction-r``: r
+from 1e-8 to 1e12 E/h at mu = 0.3).
+
+Besides status, iterations and forces, a run records its friction
+coefficient, F_t / (mu N) at the last step, and, from :func:`run_grid`, how
+far its answer (N, F_t, rms displacement) is from the reference answer of
+the same scene: GNRM at r = 1 E/h (``auto`` there when GNRM fails). A
+"converged" run whose answer is off by more than :data:`REFERENCE_RTOL` is
+a false convergence.
 
 The stopping test is the same for every method and meaningful for any E:
 atol = max(force_rtol * E h^(d-1), round-off floor at r)
@@ -25,7 +34,7 @@ import math
 import time
 import traceback
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -40,7 +49,12 @@ from fenics_contact.solvers.diagnostics import SolverSettings, Status
 from fenics_contact.solvers.stepping import RunRecord, StepRecord, solve_load_path, start_record
 from fenics_contact.verification.bench_scenes import BarScene, BlockScene, HertzScene
 from fenics_contact.verification.friction_scenes import REVERSAL, SlidingBlock
-from fenics_contact.verification.two_body_examples import IroningShort, TwoCylinders
+from fenics_contact.verification.two_body_examples import (
+    REVERSAL_PAIR,
+    IroningShort,
+    SlidingBlocks,
+    TwoCylinders,
+)
 
 #: Methods the stability grid runs by default.
 METHODS = tuple(STRATEGIES)
@@ -49,6 +63,10 @@ METHODS = tuple(STRATEGIES)
 #: its message in ``CaseRecord.message``) and non-finite outputs.
 ERROR = Status.ERROR.value
 NONFINITE = "nonfinite"
+#: Methods tried in turn, at r = 1 E/h, for the reference answer of a scene.
+REFERENCE_METHODS = ("gnrm", "auto")
+#: Largest relative deviation from the reference answer that counts as reaching it.
+REFERENCE_RTOL = 1e-6
 
 
 @dataclass(frozen=True)
@@ -100,7 +118,7 @@ def full_grid() -> list[StabilityCase]:
         for e in (-3, 0, 3)
     ]
     cases += [StabilityCase("ironing-short", "two-body-sliding", IroningShort())]
-    return cases + friction_grid()
+    return cases + friction_grid() + pair_friction_grid()
 
 
 def friction_grid() -> list[StabilityCase]:
@@ -119,6 +137,21 @@ def friction_grid() -> list[StabilityCase]:
         for e in (0, 4)
     ]
     cases += [StabilityCase("slide-reversal", "friction", SlidingBlock(schedule=REVERSAL), 1.0)]
+    return cases
+
+
+def pair_friction_grid() -> list[StabilityCase]:
+    """The sliding blocks pair with friction: mu 0 ... 10, r extremes, a load reversal."""
+    cases = [
+        StabilityCase(f"blocks-mu{mu:g}", "two-body-friction", SlidingBlocks(mu=mu), 1.0)
+        for mu in (0.0, 0.3, 1.0, 10.0)
+    ]
+    cases += [
+        StabilityCase(f"blocks-r1e{e}", "two-body-friction-r", SlidingBlocks(), 10.0**e)
+        for e in range(-8, 13, 4)
+    ]
+    cases += [StabilityCase("blocks-reversal", "two-body-friction",
+                            SlidingBlocks(path=REVERSAL_PAIR), 1.0)]
     return cases
 
 
@@ -153,11 +186,41 @@ class CaseRecord(RunRecord):
     #: displacement measure to compare with a reference (max |u| is often
     #: the prescribed value).
     u_rms: float = 0.0
+    #: Coulomb coefficient (None without friction).
+    mu: float | None = None
+    #: Where the reference answer came from ("gnrm r=1"; empty: none).
+    reference: str = ""
+    #: Largest relative deviation of N, F_t (both relative to the reference N)
+    #: and u_rms from the reference answer (None: no reference or not converged).
+    reference_deviation: float | None = None
+
+    @property
+    def tangential_force(self) -> float:
+        """Tangential contact force at the last step attempted (force)."""
+        return self.steps[-1].tangential_force if self.steps else 0.0
+
+    @property
+    def ft_ratio(self) -> float | None:
+        """F_t / (mu N) at the last step attempted (1: full slip; None without friction)."""
+        if not self.mu or self.contact_force <= 0.0:
+            return None
+        return self.tangential_force / (self.mu * self.contact_force)
+
+    @property
+    def reference_reached(self) -> bool | None:
+        """Converged to the reference answer within REFERENCE_RTOL (None: no reference)."""
+        if not self.reference:
+            return None
+        return self.reference_deviation is not None and (
+            self.reference_deviation <= REFERENCE_RTOL
+        )
 
     def row(self) -> dict[str, object]:
-        """Flat row; no ``error`` column (the grid has no reference solutions)."""
+        """Flat row; the reference deviation instead of the ``error`` column."""
         d = super().row()
         d.pop("error")
+        d.update(tangential_force=self.tangential_force, ft_ratio=self.ft_ratio,
+                 reference_reached=self.reference_reached)
         return d
 
 
@@ -193,6 +256,8 @@ def run_case(
 
     try:
         problem = scene.build(ContactSettings(r=case.r, relative=True), comm)
+        mu = getattr(problem, "mu", None)
+        record.mu = None if mu is None else float(mu.value)
         atol = scaled_atol(problem, force_rtol)
         strategy = make_strategy(
             method, problem, SolverSettings(atol=atol, max_iterations=max_iterations)
@@ -229,7 +294,38 @@ def run_case(
 
 def _case_fields(record: CaseRecord) -> dict[str, object]:
     """The case's own fields of a record (not the run's)."""
-    return {k: getattr(record, k) for k in ("case", "group", "E", "nu", "load_steps")}
+    return {k: getattr(record, k) for k in ("case", "group", "E", "nu", "load_steps", "mu")}
+
+
+def deviation(record: CaseRecord, reference: CaseRecord) -> float | None:
+    """Largest relative deviation of N, F_t and u_rms from ``reference`` (None: not converged).
+
+    Forces are measured against the reference N (at least its stopping
+    tolerance, for a case without contact), u_rms against its own reference.
+    """
+    if not record.converged:
+        return None
+    force_scale = max(abs(reference.contact_force), reference.atol, 1e-300)
+    u_scale = max(reference.u_rms, 1e-300)
+    return max(abs(record.contact_force - reference.contact_force) / force_scale,
+               abs(record.tangential_force - reference.tangential_force) / force_scale,
+               abs(record.u_rms - reference.u_rms) / u_scale)
+
+
+def _reference_runs(
+    case: StabilityCase, out: Path | None, **options: float
+) -> dict[str, CaseRecord]:
+    """REFERENCE_METHODS at r = 1 E/h on the case's scene, in turn until one converges.
+
+    The runs of a case at r = 1 E/h are its own runs and write their step records.
+    """
+    runs = {}
+    for method in REFERENCE_METHODS:
+        runs[method] = run_case(replace(case, r=1.0), method,
+                                out=out if case.r == 1.0 else None, **options)
+        if runs[method].converged:
+            break
+    return runs
 
 
 def run_grid(
@@ -238,13 +334,32 @@ def run_grid(
     *,
     out: Path | None = None,
     progress: Callable[[CaseRecord], None] | None = None,
+    reference: bool = True,
     **options: float,
 ) -> list[CaseRecord]:
-    """Run every method on every case; ``options`` go to :func:`run_case`."""
+    """Run every method on every case; ``options`` go to :func:`run_case`.
+
+    With ``reference``, each record gets its deviation from the reference
+    answer of its scene (:data:`REFERENCE_METHODS` at r = 1 E/h, run once per
+    scene; a case at r = 1 E/h that first needs the reference keeps those
+    runs as its own runs of these methods).
+    """
     records = []
+    references: dict[str, tuple[str, dict[str, CaseRecord]]] = {}
     for case in cases:
+        owner, runs, ref = "", {}, None
+        if reference:
+            key = repr(case.scene)
+            if key not in references:
+                references[key] = (case.name, _reference_runs(case, out, **options))
+            owner, runs = references[key]
+            ref = next((r for r in runs.values() if r.converged), None)
         for method in methods:
-            record = run_case(case, method, out=out, **options)
+            own = case.r == 1.0 and owner == case.name and method in runs
+            record = runs[method] if own else run_case(case, method, out=out, **options)
+            if ref is not None:
+                record.reference = f"{ref.method} r=1"
+                record.reference_deviation = deviation(record, ref)
             records.append(record)
             if progress is not None:
                 progress(record)

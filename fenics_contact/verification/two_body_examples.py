@@ -1,6 +1,7 @@
-"""Two-body examples for ``study``: two cylinders and the contact patch test.
+"""Two-body examples for ``study`` and the stability grid.
 
-Both are linear elastic (E = 200, nu = 0.3, plane strain) with one
+Two cylinders, the contact patch test and the sliding blocks with Coulomb
+friction are linear elastic (E = 200, nu = 0.3, plane strain) with one
 node-to-segment pair (upper body: striker; lower: target) and non-matching
 meshes; the nodal (vertex) rule is the only quadrature two-body contact has.
 """
@@ -16,12 +17,15 @@ from mpi4py import MPI
 
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import material
+from fenics_contact.model.pair_friction import FrictionalTwoBodyProblem
 from fenics_contact.model.pairs import Body, TwoBodyProblem
-from fenics_contact.model.problem import PrescribedDisplacement
+from fenics_contact.model.problem import PathDisplacement, PrescribedDisplacement
 from fenics_contact.scene import two_body_meshing as tbm
 
 #: Prescribed components by facet tag (None: free), values at load factor 1 (length).
 Fixed = dict[int, tuple[float | None, ...]]
+#: Knots (t, u_1, ..., u_d) of a piecewise-linear displacement path (length).
+Path = tuple[tuple[float, ...], ...]
 
 
 def linear_pair(
@@ -30,6 +34,10 @@ def linear_pair(
     fixed: Fixed,
     E_upper: float = 200.0,
     E_lower: float = 200.0,
+    *,
+    paths: dict[int, Path] | None = None,
+    mu: float | None = None,
+    tangential_r_max: float | None = 2.0,
 ) -> TwoBodyProblem:
     """Linear elastic bodies (nu = 0.3) on a :mod:`~fenics_contact.scene.two_body_meshing` mesh.
 
@@ -42,15 +50,23 @@ def linear_pair(
         fixed: prescribed displacements by facet tag, proportional to the load factor.
         E_upper: Young's modulus of the striker (stress).
         E_lower: Young's modulus of the target (stress).
+        paths: displacements by facet tag along a piecewise-linear path in the load factor.
+        mu: Coulomb coefficient (None: frictionless :class:`TwoBodyProblem`;
+            a number, 0 included: :class:`FrictionalTwoBodyProblem`).
+        tangential_r_max: cap of r_t relative to E/L (friction only; None: r_t = r).
     """
     ft = md.facet_tags
     bodies = [Body("upper", tbm.STRIKER_TAG, material("linear", E_upper, 0.3)),
               Body("lower", tbm.TARGET_TAG, material("linear", E_lower, 0.3))]
-    return TwoBodyProblem(
-        md.mesh, md.cell_tags, bodies,
-        ft.find(tbm.STRIKER_FACE_TAG), ft.find(tbm.TARGET_FACE_TAG), settings,
-        prescribed=[PrescribedDisplacement(ft.find(tag), value) for tag, value in fixed.items()],
-    )
+    prescribed = [PrescribedDisplacement(ft.find(tag), value) for tag, value in fixed.items()]
+    prescribed += [PathDisplacement(ft.find(tag), (None,) * len(path[0][1:]), path=path)
+                   for tag, path in (paths or {}).items()]
+    args = (md.mesh, md.cell_tags, bodies, ft.find(tbm.STRIKER_FACE_TAG),
+            ft.find(tbm.TARGET_FACE_TAG), settings)
+    if mu is None:
+        return TwoBodyProblem(*args, prescribed=prescribed)
+    return FrictionalTwoBodyProblem(*args, mu=mu, tangential_r_max=tangential_r_max,
+                                    prescribed=prescribed)
 
 
 def hemispheres_fixed(push: float) -> Fixed:
@@ -86,15 +102,26 @@ class TwoCylinders:
 
 @dataclass
 class BlockOnBlock:
-    """The contact patch test: a block pressed by 0.01 onto another (8 and 11 divisions)."""
+    """The contact patch test: a block pressed by 0.01 onto another (8 and 11 divisions).
+
+    Attributes:
+        n_upper, n_lower: divisions along x of the striker and the target.
+        steps: load steps.
+        upper_width: width of the striker, centred on the 1-wide target (None: 1).
+    """
 
     n_upper: int = 8
     n_lower: int = 11
     steps: int = 2
+    upper_width: float | None = None
 
     def build(self, settings: ContactSettings, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyProblem:
         """Mesh both blocks and create the problem."""
-        return linear_pair(self.mesh(comm), settings, self.FIXED)
+        return self.problem(self.mesh(comm), settings)
+
+    def problem(self, md: MeshData, settings: ContactSettings) -> TwoBodyProblem:
+        """The problem on the mesh ``md`` of :meth:`mesh` (keep ``md`` for its facet tags)."""
+        return linear_pair(md, settings, self.FIXED)
 
     #: Pressed 0.01 at the top, held at the bottom, symmetric at x = 0.
     FIXED: ClassVar[Fixed] = {tbm.LOAD_TAG: (None, -0.01), tbm.SUPPORT_TAG: (None, 0.0),
@@ -102,7 +129,41 @@ class BlockOnBlock:
 
     def mesh(self, comm: MPI.Comm = MPI.COMM_WORLD) -> MeshData:
         """The two blocks' mesh (:func:`two_body_meshing.block_on_block`)."""
-        return tbm.block_on_block(comm, n_upper=self.n_upper, n_lower=self.n_lower)
+        return tbm.block_on_block(comm, n_upper=self.n_upper, n_lower=self.n_lower,
+                                  upper_width=self.upper_width)
+
+
+#: Sliding blocks: press 0.01 over load factors 0 ... 0.4, then slide 0.04 (t, dx, dy).
+PRESS_SLIDE_PAIR: Path = ((0.0, 0.0, 0.0), (0.4, 0.0, -0.01), (1.0, 0.04, -0.01))
+#: Press as above, slide +0.04 by t = 0.7, then back to -0.02: the friction reverses.
+REVERSAL_PAIR: Path = ((0.0, 0.0, 0.0), (0.4, 0.0, -0.01), (0.7, 0.04, -0.01),
+                       (1.0, -0.02, -0.01))
+
+
+@dataclass
+class SlidingBlocks(BlockOnBlock):
+    """A 0.6-wide block (6 divisions) pressed onto a 1-wide one (9), then slid, with friction.
+
+    The striker's top follows ``path`` (t, dx, dy); the target's bottom is
+    clamped. Coulomb coefficient ``mu`` (None: the frictionless pair), r_t =
+    min(r, tangential_r_max E/L) (None: r_t = r).
+    """
+
+    n_upper: int = 6
+    n_lower: int = 9
+    steps: int = 10
+    upper_width: float | None = 0.6
+    mu: float | None = 0.3
+    path: Path = PRESS_SLIDE_PAIR
+    tangential_r_max: float | None = 2.0
+
+    def problem(self, md: MeshData, settings: ContactSettings) -> TwoBodyProblem:
+        """The (frictional) problem on the mesh ``md`` of :meth:`mesh`."""
+        return linear_pair(
+            md, settings, {tbm.SUPPORT_TAG: (0.0, 0.0)},
+            paths={tbm.LOAD_TAG: self.path}, mu=self.mu,
+            tangential_r_max=self.tangential_r_max,
+        )
 
 
 @dataclass
