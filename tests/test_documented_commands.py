@@ -53,6 +53,10 @@ COMMANDS: dict[str, str | tuple[str, str]] = {
     "python benchmarks/ladder3d.py --table": "{python} benchmarks/ladder3d.py --table --out {out}",
     "fenics-contact tradeoff --out results/tradeoff":
         "{cli} tradeoff --scene bar --methods gnrm --r 1 --meshes 1 --repeats 1 --out {out}",
+    "fenics-contact tradeoff --scene friction --mu 0.1,0.3 --repeats 1 --meshes 3 "
+    "--out results/trf":
+        "{cli} tradeoff --scene friction --mu 0.3 --methods gnrm --r 1 --meshes 1 "
+        "--repeats 1 --out {out}",
     "fenics-contact stability --out results/stability":
         "{cli} stability --cases bar-r1e0 --methods gnrm --out {out}",
     "fenics-contact stability --cases E,bar-r1e12 --methods gnrm,auto":
