@@ -26,7 +26,7 @@ from mpi4py import MPI
 
 import fenics_contact  # noqa: F401  (before dolfinx)
 from fenics_contact.scene.build import build_mesh, build_two_body_problem, tagged_facets
-from fenics_contact.scene.schema import load_scene
+from fenics_contact.scene.schema import Scene, load_scene
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.predictor import Extrapolated
 from fenics_contact.solvers.stepping import solve_load_path
@@ -44,21 +44,26 @@ def order(residuals: list[float]) -> float:
     return float(np.log(c / b) / np.log(b / a))
 
 
+def setup(scene: Scene):
+    """Problem, indenter top facets, the top's path knots and the scene's strategy."""
+    body = build_mesh(scene, MPI.COMM_WORLD)
+    problem = build_two_body_problem(scene, body)
+    top = tagged_facets(body, scene, "top", "top")
+    knots = np.asarray(next(d for d in scene.dirichlet if d.path).path)
+    strategy = make_strategy(scene.solver.method, problem, scene.solver)
+    if scene.solver.predictor == "extrapolate":
+        strategy = Extrapolated(strategy)
+    return problem, top, knots, strategy
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scene", type=Path, default=Path("scenes/ironing.toml"))
     parser.add_argument("--out", type=Path, default=Path("results/bench"))
     args = parser.parse_args()
     scene = load_scene(args.scene)
-    body = build_mesh(scene, MPI.COMM_WORLD)
-    problem = build_two_body_problem(scene, body)
-    top = tagged_facets(body, scene, "top", "top")
-    path_spec = next(d for d in scene.dirichlet if d.path)
-    knots = np.asarray(path_spec.path)
+    problem, top, knots, strategy = setup(scene)
     radius = 0.5
-    strategy = make_strategy(scene.solver.method, problem, scene.solver)
-    if scene.solver.predictor == "extrapolate":
-        strategy = Extrapolated(strategy)
     rows: list[dict] = []
 
     def on_step(step) -> None:

@@ -43,15 +43,12 @@ from pathlib import Path
 
 import harness
 import numpy as np
-from ironing import order
+from ironing import order, setup
 
 from mpi4py import MPI
 
 import fenics_contact  # noqa: F401  (before dolfinx)
-from fenics_contact.scene.build import build_mesh, build_two_body_problem, tagged_facets
 from fenics_contact.scene.schema import load_scene
-from fenics_contact.solvers import make_strategy
-from fenics_contact.solvers.predictor import Extrapolated
 from fenics_contact.solvers.stepping import solve_load_path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -75,13 +72,7 @@ def run(mu: float | None, coarse: bool, indenter_E: float | None = None) -> dict
     if coarse:
         scene = dataclasses.replace(scene, mesh=dataclasses.replace(
             scene.mesh, parameters={"h_indenter": 0.08, "h_block": 0.12}))
-    body = build_mesh(scene, MPI.COMM_WORLD)
-    problem = build_two_body_problem(scene, body)
-    top = tagged_facets(body, scene, "top", "top")
-    knots = np.asarray(next(d for d in scene.dirichlet if d.path).path)
-    strategy = make_strategy(scene.solver.method, problem, scene.solver)
-    if scene.solver.predictor == "extrapolate":
-        strategy = Extrapolated(strategy)
+    problem, top, knots, strategy = setup(scene)
     rows: list[dict] = []
 
     def on_step(step) -> None:
