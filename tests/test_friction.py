@@ -464,7 +464,7 @@ def test_sua_at_huge_r_is_not_converged_until_the_coulomb_law_holds(monkeypatch)
     iterations, slip 1.8e-6 at sticking nodes (36 gap_tol h) and
     |tau - lam_t| = 3.6e-3; with it 45 iterations and slip 4.7e-8.
     """
-    import fenics_contact.solvers.base as base
+    import fenics_contact.solvers.diagnostics as diagnostics
     from fenics_contact.solvers.diagnostics import coulomb_admissibility, signorini_admissibility
 
     block = SlidingBlock(schedule=FIRST_SLIDE, steps=9)
@@ -485,7 +485,7 @@ def test_sua_at_huge_r_is_not_converged_until_the_coulomb_law_holds(monkeypatch)
     assert run.converged and verdicts == [None] * 9
     assert run.steps[-1].iterations >= 30
     assert problem.coulomb_violations()[0] <= 1e-6 * problem.surface.h
-    monkeypatch.setattr(base, "contact_admissibility", signorini_admissibility)
+    monkeypatch.setattr(diagnostics, "contact_admissibility", signorini_admissibility)
     _, former, verdicts = first_slide()  # the Signorini check only, as before
     assert former.converged and former.steps[-1].iterations < 20
     assert verdicts[:8] == [None] * 8 and "slip at sticking nodes" in verdicts[-1]

@@ -54,9 +54,7 @@ from fenics_contact.solvers.diagnostics import (
     ConvergenceMonitor,
     SolverSettings,
     Status,
-    all_of,
-    contact_admissibility,
-    prescribed_admissibility,
+    admissibility,
 )
 from fenics_contact.solvers.newton import NewtonKernel
 
@@ -231,8 +229,7 @@ class AutoStrategy(NewtonStrategy):
         """Newton on the Alart-Curnier system, plain or with backtracking."""
         monitor = ConvergenceMonitor(
             settings, observer=self._progress(tally),
-            admissible=all_of(prescribed_admissibility(self.problem, settings),
-                              contact_admissibility(self.problem, settings)),
+            admissible=admissibility(self.problem, settings),
         )
         if line_search:
             status, steps = self._line_search_loop(self.kernel, monitor)

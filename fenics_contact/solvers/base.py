@@ -13,9 +13,7 @@ from fenics_contact.solvers.diagnostics import (
     ConvergenceMonitor,
     SolverSettings,
     Status,
-    all_of,
-    contact_admissibility,
-    prescribed_admissibility,
+    admissibility,
 )
 from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.newton import NewtonKernel
@@ -191,10 +189,8 @@ class NewtonStrategy:
         settings = settings or self.settings
         return ConvergenceMonitor(
             settings, observer=self.observer,
-            admissible=all_of(
-                prescribed_admissibility(self.problem, settings),
-                contact_admissibility(self.problem, settings) if self.exact_constraint else None,
-            ),
+            admissible=admissibility(self.problem, settings,
+                                     exact_constraint=self.exact_constraint),
         )
 
     def residual_norm(self) -> float:

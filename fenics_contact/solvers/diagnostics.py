@@ -342,3 +342,17 @@ def contact_admissibility(problem, settings: SolverSettings) -> Check | None:
     """
     return all_of(signorini_admissibility(problem, settings),
                   coulomb_admissibility(problem, settings))
+
+
+def admissibility(
+    problem, settings: SolverSettings, *, exact_constraint: bool = True
+) -> Check | None:
+    """What a converged iterate must satisfy beside the residual test.
+
+    The prescribed displacements, then (when the strategy enforces the
+    constraint exactly, i.e. not penalty) the Signorini and Coulomb tests.
+    """
+    return all_of(
+        prescribed_admissibility(problem, settings),
+        contact_admissibility(problem, settings) if exact_constraint else None,
+    )
