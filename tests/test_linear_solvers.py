@@ -108,3 +108,32 @@ def test_parallel_iterative_run_matches_serial() -> None:
     assert world[1] == serial[1]
     assert world[2] == pytest.approx(serial[2], rel=1e-9)
     assert world[3] == pytest.approx(serial[3], rel=1e-9)
+
+
+@pytest.mark.parametrize("release", ["destroy", "collect"])
+def test_solver_options_leave_with_their_kernel(release: str) -> None:
+    """The field-split defaults a kernel puts into PETSc's database go when the kernel goes.
+
+    (Before, every iterative kernel left its prefixed options behind, and the
+    test run ended with PETSc's "options you set that were not used".)
+    """
+    import gc
+
+    from petsc4py import PETSc
+
+    from fenics_contact.solvers.condensed import kernel_for
+
+    problem = BlockIndentation(n=4).build(ContactSettings(r=1.0), MPI.COMM_WORLD)
+    kernel = kernel_for(problem.augmented_system(), LinearSolverSettings(kind="iterative"))
+    prefix = kernel._prefix
+    mine = [k for k in PETSc.Options().getAll() if k.startswith(prefix)]
+    assert any("fieldsplit_u_pc_type" in k for k in mine)
+    # switching solvers drops the old defaults (else they would win over the new ones)
+    kernel.set_linear_solver(LinearSolverSettings(kind="iterative", amg_threshold=0.05))
+    assert PETSc.Options().getReal(f"{prefix}fieldsplit_u_pc_gamg_threshold") == 0.05
+    if release == "destroy":
+        kernel.destroy()
+    else:
+        del kernel
+        gc.collect()
+    assert [k for k in PETSc.Options().getAll() if k.startswith(prefix)] == []

@@ -165,6 +165,26 @@ class ContactSurface:
             fem.form(mu * self.ds_nodal, entity_maps=self.entity_maps)
         )
 
+    def parent_dofs(self, V: fem.FunctionSpace) -> np.ndarray:
+        """The block (vertex dof) of the body's P1 space ``V`` at each local multiplier dof.
+
+        Found through the submesh's geometry-node map, cell by cell: a
+        multiplier node maps to its own parent vertex even where another body
+        has a vertex at the same point (two bodies meshed touching).
+        Ghost multiplier dofs are included (length: owned + ghost).
+        """
+        parent_node = np.asarray(self.node_map)
+        sub_nodes = self.submesh.geometry.dofmaps[0]
+        q_dofs = self.Q.dofmap.list
+        n_vertices = q_dofs.shape[1]
+        body_block = np.full(V.mesh.geometry.x.shape[0], -1, dtype=np.int64)
+        body_nodes = V.mesh.geometry.dofmaps[0]
+        body_block[body_nodes[:, : V.dofmap.list.shape[1]].reshape(-1)] = V.dofmap.list.reshape(-1)
+        index_map = self.Q.dofmap.index_map
+        out = np.full(index_map.size_local + index_map.num_ghosts, -1, dtype=np.int64)
+        out[q_dofs.reshape(-1)] = body_block[parent_node[sub_nodes[:, :n_vertices].reshape(-1)]]
+        return out
+
     @property
     def num_dofs(self) -> int:
         """Global number of multiplier degrees of freedom."""

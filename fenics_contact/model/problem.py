@@ -180,9 +180,10 @@ class ContactState:
 
     Attributes:
         gap: nodal gaps at the owned multiplier nodes (length).
-        pressure: transmitted nodal pressure min(lam + r g, 0) (<= 0, stress).
+        pressure: nodal contact pressure (<= 0, stress): the multiplier for
+            multiplier strategies, r min(g, 0) for the penalty method.
         multiplier: nodal multiplier lam.
-        active_count: global number of nodes with lam + r g < 0.
+        active_count: global number of nodes with a pressure < 0.
         max_penetration: global max of -min(g, 0) (length).
         contact_force: global normal force -int p dA on the reference surface
             (force; per unit thickness in 2D). Multiplier strategies report
@@ -214,7 +215,7 @@ class ContactState:
         Args:
             comm: communicator of the problem.
             gap: owned nodal gaps (length).
-            pressure: owned nodal min(lam + r g, 0) (<= 0); active where < 0.
+            pressure: owned nodal pressure (<= 0, stress); active where < 0.
             multiplier: owned nodal multipliers.
             local_force: this rank's share of the contact force (force).
         """
@@ -584,13 +585,35 @@ class ContactProblem(ProblemBase):
 
     # -- diagnostics -----------------------------------------------------------
     def contact_state(self) -> ContactState:
-        """Nodal gaps, pressures, the active set and global summaries."""
+        """Nodal gaps, pressures, the active set and global summaries.
+
+        With a multiplier method the pressure is the multiplier (see
+        :meth:`nodal_pressure`), so the written field, the active set and the
+        force agree at every r.
+        """
         gap = self.surface.nodal(self._gap_form)
+        lam = self.lam.x.array[: gap.size].copy()
         return ContactState.gathered(
-            self.comm, gap, self.surface.nodal(self._pressure_form),
-            self.lam.x.array[: gap.size].copy(),
+            self.comm, gap, self.nodal_pressure(lam), lam,
             fem.assemble_scalar(self._contact_force_form()),
         )
+
+    def nodal_pressure(self, lam: np.ndarray) -> np.ndarray:
+        """Owned nodal contact pressure (<= 0, stress) of the current iterate.
+
+        Multiplier strategies: the multiplier, min(lam, 0), with values
+        below 1e-12 of the largest pressure set to zero (the round-off of a
+        linear solve at open nodes). The transmitted min(lam + r g, 0) would
+        carry the round-off r * eps * g of the gap, of the order of the
+        pressure itself at r = 1e12 E/h. The penalty method, whose multiplier
+        is zero, transmits r min(g, 0).
+        """
+        if not self.multiplier_is_pressure:
+            return self.surface.nodal(self._pressure_form)
+        pressure = np.minimum(lam, 0.0)
+        peak = self.comm.allreduce(float(np.max(-pressure, initial=0.0)), op=MPI.MAX)
+        pressure[pressure > -1e-12 * peak] = 0.0
+        return pressure
 
     def _contact_force_form(self) -> fem.Form:
         """The force from the multiplier when it is the pressure, else from min(lam + r g, 0).

@@ -60,18 +60,15 @@ def write_csv(path: Path, rows: Iterable[Mapping[str, object]]) -> None:
 class SurfaceToBody:
     """Copies nodal values on the contact submesh into a P1 field on the body.
 
-    Nodes are matched by their (identical) reference coordinates on each
-    process; body nodes off the contact surface keep the fill value.
+    Each multiplier node is mapped to its own parent vertex through the
+    submesh's node map (never by coordinates: two bodies meshed touching have
+    distinct vertices at one point); body nodes off the contact surface keep
+    the fill value.
     """
 
     def __init__(self, problem: ContactProblem) -> None:
         self.W = fem.functionspace(problem.domain, ("Lagrange", 1))
-        body = self.W.tabulate_dof_coordinates()
-        surface = problem.Q.tabulate_dof_coordinates()
-        index = {tuple(np.round(p, 12)): i for i, p in enumerate(body)}
-        self.body_dofs = np.array(
-            [index[tuple(np.round(p, 12))] for p in surface], dtype=np.int32
-        )
+        self.body_dofs = problem.surface.parent_dofs(self.W).astype(np.int32)
 
     def field(self, name: str, values: np.ndarray, fill: float = 0.0) -> fem.Function:
         """A body P1 function holding ``values`` (all local surface dofs) on the surface."""

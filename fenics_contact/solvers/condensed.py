@@ -193,7 +193,8 @@ class CondensedKernel(NewtonKernel):
             self.A.zeroRowsColumns(self._bc_rows, 1.0, self.z, self.b)
 
     def destroy(self) -> None:
-        """Free the PETSc objects."""
+        """Free the PETSc objects and remove the solver's options from the database."""
+        self._forget()
         for obj in (self.ksp, self.A, self.A_ext, self.P, self.b, self.b_ext, self.x,
                     self.dx, self.z):
             if obj is not None:

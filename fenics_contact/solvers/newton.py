@@ -13,6 +13,7 @@ into compilation, assembly and linear solves.
 from __future__ import annotations
 
 import itertools
+import weakref
 
 import numpy as np
 from dolfinx import fem
@@ -25,6 +26,15 @@ from fenics_contact.solvers.linear import LinearSolverSettings, configure_ksp
 from fenics_contact.solvers.timing import KernelTimings, stopwatch
 
 _prefix_counter = itertools.count()
+
+
+def _forget_options(names: list[str]) -> None:
+    """Remove options from PETSc's database (those a kernel put there for its solver)."""
+    db = PETSc.Options()
+    for name in names:
+        if db.hasName(name):
+            db.delValue(name)
+    names.clear()
 
 
 class NewtonKernel:
@@ -66,6 +76,10 @@ class NewtonKernel:
         self._keep: tuple = ()
         self.linear_solves = 0
         self.residual_norm = np.inf
+        #: Options this kernel put into PETSc's database; removed with the kernel
+        #: (destroyed or collected), so none outlives its solver.
+        self._options: list[str] = []
+        self._forget = weakref.finalize(self, _forget_options, self._options)
 
     def _work_vectors(self) -> None:
         """Vectors b (residual), x (unknowns) and dx (Newton update) on the unknowns' spaces."""
@@ -80,11 +94,17 @@ class NewtonKernel:
         """(Re)create the linear solver; the matrix and vectors are kept."""
         if self.ksp is not None:
             self.ksp.destroy()
+        _forget_options(self._options)  # the previous solver's defaults must not win
         self.linear = settings
         self.ksp = PETSc.KSP().create(self.A.comm)
         self.ksp.setOptionsPrefix(self._prefix)
         self.ksp.setOperators(self.A)
+        before = set(PETSc.Options().getAll())
         self._keep = configure_ksp(self.ksp, self.A, self.spaces, settings)
+        self._options.extend(
+            name for name in PETSc.Options().getAll()
+            if name.startswith(self._prefix) and name not in before
+        )
 
     # -- state transfer --------------------------------------------------------
     def _pull(self) -> None:
@@ -166,6 +186,7 @@ class NewtonKernel:
         return True
 
     def destroy(self) -> None:
-        """Free the PETSc objects."""
+        """Free the PETSc objects and remove the solver's options from the database."""
+        self._forget()
         for obj in (self.ksp, self.A, self.b, self.x, self.dx):
             obj.destroy()
