@@ -78,9 +78,10 @@ def test_inverted_step_is_cut_back_then_refused_with_its_place():
     assert [s.step for s in written] == [1]
     failed = path.steps[1]
     assert 0.375 <= failed.load_factor < 0.4  # cut back below the inverting load
-    assert failed.cutbacks == 4
+    assert failed.cutbacks == 3  # halvings; the fourth attempt failed too
     assert failed.min_det_F <= 0.0
-    assert "elements inverted (det F = " in failed.message
+    assert "after 4 attempts, the increment halved 3 times" in failed.message
+    assert "inverted: elements turned inside out (det F = " in failed.message
     assert "near (" in failed.message and "reduce the load" in failed.message
     assert np.all(np.isfinite(failed.worst_cell))
     # the state left behind is the last accepted one

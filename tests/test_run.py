@@ -114,6 +114,31 @@ def test_written_pressure_is_the_multiplier_at_huge_r(tmp_path):
     assert np.max(np.abs(fields[1e12] - fields[1.0])) <= 1e-8 * peak
 
 
+@pytest.mark.parametrize(("cutbacks", "attempts"), [
+    (0, "1 attempt, no cut-back"),
+    (1, "2 attempts, the increment halved once"),
+    (2, "3 attempts, the increment halved 2 times"),
+])
+def test_failed_first_step_is_worded_truthfully(tmp_path, capsys, cutbacks, attempts):
+    """No "steps 1-0", and the attempts and halvings counted alike (both once "5 and 4")."""
+    text = (SCENES / "paper_ex2.toml").read_text()
+    text = text.replace('method = "gnrm"', 'method = "sua"').replace(
+        "max_iterations = 50", f"max_iterations = 3\nmax_cutbacks = {cutbacks}"
+    )
+    scene = tmp_path / "failing.toml"
+    scene.write_text(text)
+    out = tmp_path / "out"
+    assert main(["run", str(scene), "--out", str(out), "--quiet"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1
+    assert err[0].startswith("fenics-contact: load step 1 of 10 did not converge (max_iterations")
+    assert err[0].endswith(
+        f"after {attempts}); no load step finished, so {out} holds no solution.xdmf"
+    )
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["steps"][0]["cutbacks"] == cutbacks
+
+
 def test_failing_run_exits_nonzero_and_keeps_finished_steps(tmp_path, capsys):
     text = (SCENES / "paper_ex2.toml").read_text()
     text = text.replace('method = "gnrm"', 'method = "sua"').replace(

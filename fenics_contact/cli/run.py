@@ -30,6 +30,14 @@ def _checkpoint_step(out: Path) -> int:
         return 0
 
 
+def _kept(done: int, out: Path) -> str:
+    """Where the finished load steps 1 .. done are, in words."""
+    if done == 0:
+        return f"no load step finished, so {out} holds no solution.xdmf"
+    steps = "step 1 is" if done == 1 else f"steps 1-{done} are"
+    return f"{steps} in {out}/solution.xdmf"
+
+
 def _stopped(
     stop: StopRequested, args: argparse.Namespace, out: Path, steps: int, done: int
 ) -> None:
@@ -40,8 +48,7 @@ def _stopped(
     if comm.rank != 0:
         return
     if done:
-        where = (f"steps 1-{done} are in {out}/solution.xdmf; resume with: "
-                 f"{_resume_command(args, out, comm.size)}")
+        where = f"{_kept(done, out)}; resume with: {_resume_command(args, out, comm.size)}"
     else:
         where = f"no load step finished in {out}; nothing to resume, run it again"
     print(
@@ -114,12 +121,9 @@ def _solve(
     path = outcome.path
     if not path.converged:
         failed = path.steps[-1]
-        done = len(path.steps) - 1
         print(
             f"fenics-contact: load step {failed.step} of {steps} did not converge "
-            f"({failed.status} after {failed.cutbacks} cut-backs"
-            + (f": {failed.message}" if failed.message else "")
-            + f"); steps 1-{done} are in {out}/solution.xdmf",
+            f"({failed.message or failed.status}); {_kept(failed.step - 1, out)}",
             file=sys.stderr,
         )
         return 1

@@ -201,18 +201,25 @@ def _absorb(record: StepRecord, result: SolveResult, run: RunRecord) -> None:
     record.residuals.append(result.residuals)
 
 
+def _attempts(record: StepRecord) -> str:
+    """How often the failed step was tried, in words: '5 attempts, the increment halved 4 times'."""
+    halved = record.cutbacks
+    if halved == 0:
+        return "1 attempt, no cut-back"
+    times = "once" if halved == 1 else f"{halved} times"
+    return f"{halved + 1} attempts, the increment halved {times}"
+
+
 def _failure_message(record: StepRecord, t_try: float) -> str:
     if record.status == Status.INVERTED:
         x = ", ".join(f"{c:.4g}" for c in record.worst_cell)
         return (
-            f"elements inverted (det F = {record.min_det_F:.3g} <= 0) near ({x}) at load "
-            f"factor {t_try:.4g}, even with the increment halved {record.cutbacks - 1} times; "
+            f"inverted: elements turned inside out (det F = {record.min_det_F:.3g} <= 0) "
+            f"near ({x}) at load "
+            f"factor {t_try:.4g} after {_attempts(record)}; "
             "reduce the load, its initial penetration or r, or refine the mesh there"
         )
-    return (
-        f"{record.status} at load factor {t_try:.4g} with the increment halved "
-        f"{record.cutbacks - 1} times"
-    )
+    return f"{record.status} at load factor {t_try:.4g} after {_attempts(record)}"
 
 
 def start_record(strategy: Strategy) -> RunRecord:
@@ -286,7 +293,6 @@ def solve_load_path(
                     continue
                 status = Status.INVERTED
             problem.restore(saved)
-            step.cutbacks += 1
             halvings += 1
             if halvings > max_cutbacks or increment / 2 < smallest * (1 - 1e-12):
                 step.status = status.value
@@ -294,6 +300,7 @@ def solve_load_path(
                 step.message = _failure_message(step, t_try)
                 break
             increment /= 2
+            step.cutbacks += 1
         step.wall_s = time.perf_counter() - start
         state = problem.contact_state()
         step.active_count = state.active_count
