@@ -40,6 +40,8 @@ def _value(v) -> str:
         return '"' + v + '"'
     if isinstance(v, float) and math.isinf(v):
         return "inf" if v > 0 else "-inf"
+    if isinstance(v, float) and math.isnan(v):
+        return "nan"
     if isinstance(v, list):
         return "[" + ", ".join(_value(x) for x in v) + "]"
     if isinstance(v, dict):
@@ -96,7 +98,20 @@ def edit(**changes):
 SCHEMA_CASES = [
     ("number-missing", edit(material__E=None), r"\[material\] E is missing: give a number"),
     ("number-type", edit(material__E="big"), r"\[material\] E = 'big': must be a number"),
-    ("number-finite", edit(material__E=math.inf), r"\[material\] E = inf: must be finite"),
+    ("number-finite", edit(material__E=math.inf),
+     r"\[material\] E = inf: holds a NaN or infinite number; give finite numbers"),
+    ("path-nan", edit(dirichlet__path=[[0.0, 0.0, 0.0], [1.0, 0.0, math.nan]],
+                      dirichlet__value=None),
+     r"\[dirichlet 1\] path = .*nan\]\]: holds a NaN or infinite number at \[1\]\[2\]"),
+    ("vector-inf", edit(obstacle__normal=[0.0, -math.inf]),
+     r"\[obstacle\] normal = \[0.0, -inf\]: holds a NaN or infinite number at \[1\]"),
+    ("parameter-nan", edit(mesh__parameters={"h": math.nan}),
+     r"\[mesh\] parameters = \{'h': nan\}: holds a NaN"),
+    ("steps-bound", edit(solver__steps=10**9),
+     r"\[solver\] steps = 1000000000: must be at most 100000"),
+    ("iterations-bound", edit(solver__max_iterations=10**9), r"must be at most 100000"),
+    ("friction-key-alone", edit(contact__tangential_r_max=1.0),
+     r"\[contact\] tangential_r_max = 1.0: is a friction setting, but there is no mu"),
     ("number-positive", edit(contact__r=0.0), r"\[contact\] r = 0.0: must be finite and > 0"),
     ("integer", edit(solver__steps=0), r"\[solver\] steps = 0: must be an integer >= 1"),
     ("integer-type", edit(solver__max_cutbacks=1.5), r"max_cutbacks = 1.5: must be an integer"),
@@ -426,3 +441,116 @@ def test_output_folder_not_writable(tmp_path, monkeypatch):
                        r"\(.*: Permission denied\); choose a writable --out"):
         prepare_output_folder(tmp_path / "a" / "b")
     assert not (tmp_path / "a").exists()
+
+
+# -- checks that need the mesh (scene/checks.py) ------------------------------------------
+def test_3d_mesh_in_a_2d_scene_names_the_dimensions(tmp_path):
+    """Not "tag 'zmax' is not a 1D physical group": the dimensions disagree."""
+    scene = base()
+    scene["mesh"] = {"file": str(MESHES / "block.geo")}
+    scene["dirichlet"][0]["tag"] = "zmax"
+    scene["contact"]["tag"] = "zmin"
+    with pytest.raises(SceneError, match=r"\[scene\] dimension = 2, but block.geo is a 3D mesh "
+                       r"\(it has 3D physical groups\); set dimension = 3"):
+        _build(write(tmp_path, scene))
+
+
+@pytest.mark.mpi
+def test_degenerate_cell_is_named_with_its_place(tmp_path, monkeypatch):
+    from dolfinx import mesh
+
+    from mpi4py import MPI
+
+    import fenics_contact.scene.build as build
+
+    generated = build.build_mesh
+
+    def collapsed(scene, comm):
+        body = generated(scene, comm)
+        x = body.domain.geometry.x
+        # the vertex at (0.25, 0.25) moved onto (0.5, 0.25): its cells lose their area
+        x[np.isclose(x[:, 0], 0.25) & np.isclose(x[:, 1], 0.25), 0] = 0.5
+        return body
+
+    monkeypatch.setattr(build, "build_mesh", collapsed)
+    with pytest.raises(SceneError, match=r"the mesh has [1-9] degenerate cell\(s\) \(zero area\), "
+                       r"e.g. near \(0\.[0-9]+, 0\.[0-9]+\).*Fix the mesh"):
+        _build(write(tmp_path, base()))
+    assert mesh is not None and MPI is not None
+
+
+BLOCKS = (Path(__file__).parent.parent / "scenes" / "block_on_block.toml").read_text()
+
+
+def _blocks(tmp_path, text=BLOCKS, geo=None):
+    """block_on_block.toml (two blocks, a pair) with the mesh path made absolute."""
+    geo = geo or MESHES / "block_on_block.geo"
+    path = tmp_path / "blocks.toml"
+    path.write_text(text.replace('"../meshes/block_on_block.geo"', f'"{geo}"'))
+    return path
+
+
+def test_pair_on_one_body_is_refused(tmp_path):
+    text = BLOCKS.replace('target = "target_face"', 'target = "top"')
+    with pytest.raises(SceneError, match=r"\[\[pair\]\] striker = 'striker_face' and target = "
+                       r"'top' both lie on body 'upper'; a pair joins two bodies"):
+        _build(_blocks(tmp_path, text))
+
+
+def test_pair_facets_inside_the_mesh_are_refused(tmp_path):
+    """Bodies meshed with shared nodes: the interface is interior, no contact surface."""
+    (tmp_path / "shared.geo").write_text(
+        "Point(1) = {0, 0, 0}; Point(2) = {1, 0, 0}; Point(3) = {1, 0.5, 0};\n"
+        "Point(4) = {0, 0.5, 0}; Point(5) = {1, 1, 0}; Point(6) = {0, 1, 0};\n"
+        "Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 1};\n"
+        "Line(5) = {3, 5}; Line(6) = {5, 6}; Line(7) = {6, 4};\n"
+        "Curve Loop(1) = {1, 2, 3, 4}; Plane Surface(1) = {1};\n"
+        "Curve Loop(2) = {-3, 5, 6, 7}; Plane Surface(2) = {2};\n"
+        "Mesh.MeshSizeMax = 0.25;\n"
+        'Physical Surface("striker", 1) = {2}; Physical Surface("target", 2) = {1};\n'
+        'Physical Curve("top", 2) = {6}; Physical Curve("striker_face", 3) = {3};\n'
+        'Physical Curve("target_face", 4) = {2}; Physical Curve("bottom", 5) = {1};\n'
+        'Physical Curve("symmetry", 6) = {4, 7};\n'
+    )
+    text = BLOCKS.replace("parameters = { n_upper = 8, n_lower = 11 }\n", "")
+    with pytest.raises(SceneError, match=r"\[\[pair\]\] striker = 'striker_face': [0-9]+ of its "
+                       r"facets are inside the mesh.*Mesh the bodies apart"):
+        _build(_blocks(tmp_path, text, tmp_path / "shared.geo"))
+
+
+@pytest.mark.mpi
+def test_floating_body_of_a_pair_is_named(tmp_path):
+    text = BLOCKS.replace('[[dirichlet]]\ntag = "bottom"\nvalue = ["free", 0.0]\n', "")
+    with pytest.raises(SceneError, match=r"\[\[body\]\] 'lower': no \[\[dirichlet\]\] condition "
+                       r"holds its rigid motions \(translation in y\), and contact holds nothing"):
+        _build(_blocks(tmp_path, text))
+
+
+def _overlapping(tmp_path, depth: float) -> Path:
+    """The blocks with the upper one ``depth`` lower: its face that far inside the lower one."""
+    geo = (MESHES / "block_on_block.geo").read_text()
+    for old in ("Point(5) = {0, H, 0}; Point(6) = {W, H, 0};",
+                "Point(7) = {W, 2 * H, 0}; Point(8) = {0, 2 * H, 0};"):
+        assert old in geo
+    geo = geo.replace("Point(5) = {0, H, 0}; Point(6) = {W, H, 0};",
+                      f"Point(5) = {{0, H - {depth}, 0}}; Point(6) = {{W, H - {depth}, 0}};")
+    geo = geo.replace("Point(7) = {W, 2 * H, 0}; Point(8) = {0, 2 * H, 0};",
+                      f"Point(7) = {{W, 2 * H - {depth}, 0}}; "
+                      f"Point(8) = {{0, 2 * H - {depth}, 0}};")
+    (tmp_path / "overlap.geo").write_text(geo)
+    return _blocks(tmp_path, BLOCKS, tmp_path / "overlap.geo")
+
+
+@pytest.mark.mpi
+def test_bodies_starting_deep_inside_each_other_are_refused(tmp_path):
+    # h = 1/8 on the striker face: 0.2 is 1.6 h
+    with pytest.raises(SceneError, match=r"the bodies start 0.2 inside each other near "
+                       r"\([0-9.]+, 0.3\), more than the striker facet size h = 0.125"):
+        _build(_overlapping(tmp_path, 0.2))
+
+
+def test_shallow_initial_overlap_is_reported_and_runs(tmp_path):
+    from fenics_contact.scene.checks import SceneWarning
+
+    with pytest.warns(SceneWarning, match=r"the bodies start 0.01 \(0.08 h\) inside each other"):
+        _build(_overlapping(tmp_path, 0.01))

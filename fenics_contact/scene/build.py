@@ -30,12 +30,15 @@ from fenics_contact.model.rigid import free_rigid_motions
 
 if TYPE_CHECKING:
     from fenics_contact.model.pairs import TwoBodyProblem
+from fenics_contact.scene.checks import (
+    SceneWarning,
+    check_bodies_held,
+    check_cells,
+    check_initial_overlap,
+    check_pair_surfaces,
+)
 from fenics_contact.scene.meshing import mesh_on_rank, open_geo
 from fenics_contact.scene.schema import GENERATOR_TAGS, BoundarySpec, Scene, SceneError
-
-
-class SceneWarning(UserWarning):
-    """A scene that will run but probably not as meant (printed before the solve)."""
 
 
 @dataclass
@@ -145,6 +148,12 @@ def _from_gmsh(scene: Scene, comm: MPI.Comm) -> BodyMesh:
     assert spec.file is not None
     groups = _physical_groups(scene, comm)
     dims = {d for d, _ in groups}
+    if dims and max(dims) > scene.dimension:
+        raise SceneError(
+            f"{scene.path.name}: [scene] dimension = {scene.dimension}, but {spec.file.name} "
+            f"is a {max(dims)}D mesh (it has {max(dims)}D physical groups); set "
+            f"dimension = {max(dims)}."
+        )
     if scene.dimension not in dims:
         raise SceneError(
             f"{scene.path.name}: [scene] dimension = {scene.dimension}, but the mesh "
@@ -278,25 +287,32 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> TwoBodyProblem:
         bodies.append(Body(spec.name, tag, material(spec.law, spec.E, spec.nu)))
     pair = scene.pairs[0]
     prescribed, tractions = boundary_conditions(scene, body)
+    striker = tagged_facets(body, scene, "pair striker", pair.striker)
+    target = tagged_facets(body, scene, "pair target", pair.target)
+    check_pair_surfaces(scene, body.domain, body.cell_tags, bodies, striker, target)
+    check_bodies_held(scene, body.domain, body.cell_tags, bodies, prescribed)
     args = (
-        body.domain, body.cell_tags, bodies,
-        tagged_facets(body, scene, "pair striker", pair.striker),
-        tagged_facets(body, scene, "pair target", pair.target),
+        body.domain, body.cell_tags, bodies, striker, target,
         ContactSettings(r=pair.r, relative=pair.relative),
     )
+    problem: TwoBodyProblem
     if pair.mu is not None:
         from fenics_contact.model.pair_friction import FrictionalTwoBodyProblem
 
-        return FrictionalTwoBodyProblem(
+        problem = FrictionalTwoBodyProblem(
             *args, mu=pair.mu, tangential_r_max=pair.tangential_r_max,
             prescribed=prescribed, tractions=tractions,
         )
-    return TwoBodyProblem(*args, prescribed=prescribed, tractions=tractions)
+    else:
+        problem = TwoBodyProblem(*args, prescribed=prescribed, tractions=tractions)
+    check_initial_overlap(scene, problem)
+    return problem
 
 
 def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProblem:
     """Mesh, material, conditions, obstacle and contact surface of a scene."""
     body = build_mesh(scene, comm)
+    check_cells(scene, body.domain)
     if scene.two_body:
         return build_two_body_problem(scene, body)
     if body.domain.geometry.dim != scene.dimension:
@@ -341,7 +357,7 @@ def check_rigid_motions(
     Contact and tractions do not count: before contact is made they hold
     nothing and the stiffness is singular.
     """
-    free = free_rigid_motions(body.domain, [(p.facets, p.value) for p in prescribed])
+    free = free_rigid_motions(body.domain, [(p.facets, p.at(1.0)) for p in prescribed])
     if free:
         raise SceneError(
             f"{scene.path.name}: the [[dirichlet]] conditions leave rigid motions of the body "

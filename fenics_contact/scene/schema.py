@@ -256,10 +256,14 @@ class _Reader:
             raise self.fail(key, f"must be < {below}.")
         return float(value)
 
-    def integer(self, key: str, default: int, *, minimum: int = 0) -> int:
+    def integer(
+        self, key: str, default: int, *, minimum: int = 0, maximum: int | None = None
+    ) -> int:
         value = self.table.get(key, default)
         if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
             raise self.fail(key, f"must be an integer >= {minimum}.")
+        if maximum is not None and value > maximum:
+            raise self.fail(key, f"must be at most {maximum}; {why_bounded(key)}")
         return int(value)
 
     def flag(self, key: str, default: bool) -> bool:
@@ -320,6 +324,38 @@ def _check_keys(path: Path, section: str, table: dict[str, Any]) -> None:
             raise SceneError(
                 f"{path.name}: unknown key {key!r} at {where}.{hint} "
                 f"Allowed: {', '.join(sorted(allowed))}."
+            )
+
+
+def _non_finite(value: object) -> list[str | int] | None:
+    """The keys and indices leading to the first NaN or infinite number in ``value``, or None."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return []
+    items = (
+        value.items() if isinstance(value, dict)
+        else enumerate(value) if isinstance(value, list) else ()
+    )
+    for key, item in items:
+        found = _non_finite(item)
+        if found is not None:
+            return [key, *found]
+    return None
+
+
+def _check_finite(path: Path, data: dict[str, Any]) -> None:
+    """Refuse a NaN or infinite number anywhere in the scene, naming where it is."""
+    for section, table in data.items():
+        tables = table if isinstance(table, list) else [table]
+        for i, entry in enumerate(tables):
+            found = _non_finite(entry)
+            if not found:
+                continue
+            name = f"[{section} {i + 1}]" if isinstance(table, list) else f"[{section}]"
+            key, *inner = found
+            at = "".join(f"[{k}]" if isinstance(k, int) else f".{k}" for k in inner)
+            raise SceneError(
+                f"{path.name}: {name} {key} = {entry[key]!r}: holds a NaN or infinite number"
+                f"{' at ' + at if at else ''}; give finite numbers."
             )
 
 
@@ -577,6 +613,11 @@ def _contact_r(reader: _Reader) -> float:
 def _friction(reader: _Reader) -> float | None:
     """The Coulomb coefficient: absent (frictionless) or a finite number >= 0."""
     if "mu" not in reader.table:
+        if "tangential_r_max" in reader.table:
+            raise reader.fail(
+                "tangential_r_max", "is a friction setting, but there is no mu: give the "
+                "Coulomb coefficient mu (0: frictionless) or remove tangential_r_max."
+            )
         return None
     mu = reader.number("mu")
     if mu < 0:
@@ -584,14 +625,31 @@ def _friction(reader: _Reader) -> float | None:
     return mu
 
 
+#: Largest load-step count and Newton-iteration limit a scene may ask for: far
+#: beyond any useful run (a million linear solves), well short of running forever.
+MAX_STEPS = 100_000
+MAX_ITERATIONS = 100_000
+#: Largest number of halvings of a load increment (2^-60 of a step is below round-off).
+MAX_CUTBACKS = 60
+
+
+def why_bounded(key: str) -> str:
+    """The fix that goes with a bounded integer key."""
+    if key == "steps":
+        return "a finer load path rarely helps past a few hundred steps; use fewer."
+    if key == "max_cutbacks":
+        return "each halves the increment; 60 halvings reach round-off."
+    return "a Newton solve that needs more has failed; lower it."
+
+
 def _solver(reader: _Reader) -> SolverSpec:
     return SolverSpec(
         method=reader.choice("method", METHODS, default="gnrm"),
-        steps=reader.integer("steps", 10, minimum=1),
-        max_iterations=reader.integer("max_iterations", 50, minimum=1),
+        steps=reader.integer("steps", 10, minimum=1, maximum=MAX_STEPS),
+        max_iterations=reader.integer("max_iterations", 50, minimum=1, maximum=MAX_ITERATIONS),
         atol=reader.number("atol", 1e-8, positive=True),
         rtol=reader.number("rtol", 1e-10) if "rtol" in reader.table else 1e-10,
-        max_cutbacks=reader.integer("max_cutbacks", 4, minimum=0),
+        max_cutbacks=reader.integer("max_cutbacks", 4, minimum=0, maximum=MAX_CUTBACKS),
         predictor=reader.choice("predictor", ("extrapolate", "previous"), default="extrapolate"),
         linear_solver=reader.choice("linear_solver", ("direct", "iterative"), default="direct"),
     )
@@ -613,6 +671,7 @@ def load_scene(path: Path | str) -> Scene:
     except OSError as exc:
         raise SceneError(f"Scene file {path} cannot be read ({exc.strerror}).") from None
     _check_keys(path, "", data)
+    _check_finite(path, data)
     head = _table(path, data, "scene")
     dimension = head.table.get("dimension")
     if dimension not in (2, 3):

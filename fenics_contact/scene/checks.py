@@ -1,0 +1,225 @@
+"""Checks of a scene that need its mesh: each raises SceneError naming the problem and the fix.
+
+They run after the mesh is read and before any Newton iteration: degenerate
+cells, contact surfaces that are not on a body's boundary or that pair a body
+with itself, bodies that nothing holds before contact, and deformable bodies
+that start deeply inside each other.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+from dolfinx import mesh
+
+from mpi4py import MPI
+
+from fenics_contact.model.problem import PrescribedDisplacement
+from fenics_contact.model.rigid import free_rigid_motions
+from fenics_contact.scene.schema import Scene, SceneError
+
+if TYPE_CHECKING:
+    from fenics_contact.model.pairs import Body, TwoBodyProblem
+
+#: A cell is degenerate when a corner Jacobian's |det| is at most this times its size^dim.
+DEGENERATE = 1e-10
+
+
+class SceneWarning(UserWarning):
+    """A scene that will run but probably not as meant (printed before the solve)."""
+
+
+#: Vertices per cell type.
+_VERTICES = {"interval": 2, "triangle": 3, "quadrilateral": 4, "tetrahedron": 4, "hexahedron": 8}
+
+
+def _where(point: np.ndarray, gdim: int) -> str:
+    return "(" + ", ".join(f"{c:.4g}" for c in point[:gdim]) + ")"
+
+
+def _first_on_any_rank(
+    comm: MPI.Comm, found: tuple[float, np.ndarray] | None
+) -> tuple[float, np.ndarray] | None:
+    """The (value, point) of the rank with the smallest value, on every rank (None: none found)."""
+    value = np.inf if found is None else found[0]
+    best, rank = comm.allreduce((value, comm.rank), op=MPI.MINLOC)
+    if not np.isfinite(best):
+        return None
+    point = comm.bcast(None if found is None else np.asarray(found[1]), root=rank)
+    return best, point
+
+
+def _corner_jacobians(domain: mesh.Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per owned cell: |det| of the Jacobian at each corner, the cell size and its midpoint."""
+    tdim = domain.topology.dim
+    gdim = domain.geometry.dim
+    cells = np.arange(domain.topology.index_map(tdim).size_local, dtype=np.int32)
+    n_vertices = _VERTICES[domain.topology.cell_type.name]
+    nodes = mesh.entities_to_geometry(domain, tdim, cells)[:, :n_vertices]
+    x = domain.geometry.x[nodes][:, :, :gdim]  # (cells, vertices, gdim)
+    if n_vertices == tdim + 1:  # simplex: one Jacobian
+        corners = [(0, [(a + 1, 1.0) for a in range(tdim)])]
+    else:  # tensor-product vertex numbering: corner bits (i, j, k)
+        corners = [
+            (c, [(c ^ (1 << a), -1.0 if (c >> a) & 1 else 1.0) for a in range(tdim)])
+            for c in range(n_vertices)
+        ]
+    dets = []
+    size = np.zeros(cells.size)
+    for c, edges in corners:
+        columns = np.stack([s * (x[:, nb] - x[:, c]) for nb, s in edges], axis=-1)
+        size = np.maximum(size, np.linalg.norm(columns, axis=1).max(axis=1))
+        dets.append(np.abs(np.linalg.det(columns)))
+    return np.stack(dets, axis=1), size, x.mean(axis=1)
+
+
+def check_cells(scene: Scene, domain: mesh.Mesh) -> None:
+    """Refuse a mesh with a degenerate (zero-area or zero-volume) cell, naming where it is."""
+    tdim, gdim = domain.topology.dim, domain.geometry.dim
+    if tdim != gdim:  # named by the dimension check
+        return
+    dets, size, mid = _corner_jacobians(domain)
+    ratio = dets.min(axis=1) / np.maximum(size, np.finfo(float).tiny) ** tdim
+    bad = np.flatnonzero(ratio <= DEGENERATE)
+    count = domain.comm.allreduce(int(bad.size), op=MPI.SUM)
+    if count == 0:
+        return
+    worst = int(bad[np.argmin(ratio[bad])]) if bad.size else None
+    found = _first_on_any_rank(
+        domain.comm, None if worst is None else (float(ratio[worst]), mid[worst])
+    )
+    assert found is not None
+    measure = "area" if tdim == 2 else "volume"
+    raise SceneError(
+        f"{scene.path.name}: the mesh has {count} degenerate cell(s) (zero {measure}), e.g. near "
+        f"{_where(found[1], gdim)}; the strain there is undefined. Fix the mesh: remove "
+        "duplicate or collapsed points and mesh again."
+    )
+
+
+def _body_cells(domain: mesh.Mesh, cell_tags: mesh.MeshTags, tag: int) -> np.ndarray:
+    """A marker over local cells: True on the cells of the body with cell tag ``tag``."""
+    tdim = domain.topology.dim
+    im = domain.topology.index_map(tdim)
+    marker = np.zeros(im.size_local + im.num_ghosts, dtype=bool)
+    marker[cell_tags.find(tag)] = True
+    return marker
+
+
+def _facets_on(domain: mesh.Mesh, marker: np.ndarray, facets: np.ndarray) -> np.ndarray:
+    """The facets among ``facets`` that border a marked cell."""
+    tdim = domain.topology.dim
+    domain.topology.create_connectivity(tdim - 1, tdim)
+    f2c = domain.topology.connectivity(tdim - 1, tdim)
+    return np.array([f for f in facets if marker[f2c.links(int(f))].any()], dtype=np.int32)
+
+
+def check_pair_surfaces(
+    scene: Scene,
+    domain: mesh.Mesh,
+    cell_tags: mesh.MeshTags,
+    bodies: Sequence[Body],
+    striker: np.ndarray,
+    target: np.ndarray,
+) -> None:
+    """Striker and target lie on the boundary, each on one body, and on two different bodies."""
+    comm = domain.comm
+    tdim = domain.topology.dim
+    domain.topology.create_connectivity(tdim - 1, tdim)
+    exterior = mesh.exterior_facet_indices(domain.topology)
+    pair = scene.pairs[0]
+    owners: dict[str, list[str]] = {}
+    for role, facets, tag in (("striker", striker, pair.striker), ("target", target, pair.target)):
+        inner = comm.allreduce(int(np.setdiff1d(facets, exterior).size), op=MPI.SUM)
+        if inner:
+            raise SceneError(
+                f"{scene.path.name}: [[pair]] {role} = {tag!r}: {inner} of its facets are inside "
+                "the mesh, not on a body's boundary (the bodies share nodes there). Mesh the "
+                "bodies apart (in a .geo: Geometry.AutoCoherence = 0, or separate surfaces) "
+                "so each contact surface is a boundary."
+            )
+        owners[role] = [
+            b.name for b in bodies
+            if comm.allreduce(
+                _facets_on(domain, _body_cells(domain, cell_tags, b.tag), facets).size,
+                op=MPI.SUM,
+            )
+        ]
+    if owners["striker"] == owners["target"] and len(owners["striker"]) == 1:
+        raise SceneError(
+            f"{scene.path.name}: [[pair]] striker = {pair.striker!r} and target = "
+            f"{pair.target!r} both lie on body {owners['striker'][0]!r}; a pair joins two "
+            "bodies: give the target surface of the other body."
+        )
+
+
+def check_bodies_held(
+    scene: Scene,
+    domain: mesh.Mesh,
+    cell_tags: mesh.MeshTags,
+    bodies: Sequence[Body],
+    prescribed: Sequence[PrescribedDisplacement],
+) -> None:
+    """Every body's rigid motions are held by its own Dirichlet conditions (not by contact)."""
+    for body in bodies:
+        marker = _body_cells(domain, cell_tags, body.tag)
+        own = [(_facets_on(domain, marker, p.facets), p.at(1.0)) for p in prescribed]
+        free = free_rigid_motions(domain, own)
+        if free:
+            raise SceneError(
+                f"{scene.path.name}: [[body]] {body.name!r}: no [[dirichlet]] condition holds "
+                f"its rigid motions ({'; '.join(free)}), and contact holds nothing before it "
+                f"closes. Fix: prescribe components on a face of {body.name!r} (e.g. a "
+                "support, a symmetry plane or a driven face)."
+            )
+
+
+def check_initial_overlap(scene: Scene, problem: TwoBodyProblem) -> float:
+    """Refuse bodies that start inside each other deeper than the striker facet size h.
+
+    Only striker nodes whose projection falls on a target facet count. A
+    shallower overlap is resolved by the first step and reported as a
+    :class:`SceneWarning`. Returns the depth (length).
+    """
+    comm = problem.comm
+    state = problem.contact_state()
+    n = state.gap.size
+    on_facet = problem.pair.projection.overshoot[:n] <= 1e-12
+    depth = np.where(on_facet, -state.gap, 0.0)
+    worst = int(np.argmax(depth)) if n else None
+    found = _first_on_any_rank(
+        comm,
+        None if worst is None or depth[worst] <= 0.0
+        else (-float(depth[worst]), problem.nodal_coordinates()[worst]),
+    )
+    if found is None:
+        return 0.0
+    deepest, where = -found[0], _where(found[1], problem.domain.geometry.dim)
+    h = problem.surface.h
+    if deepest > h:
+        raise SceneError(
+            f"{scene.path.name}: the bodies start {deepest:.4g} inside each other near {where}, "
+            f"more than the striker facet size h = {h:.4g}; move one body out of the other in "
+            "the mesh and let [[dirichlet]] values bring them into contact."
+        )
+    if deepest > 1e-6 * h:
+        warnings.warn(
+            SceneWarning(
+                f"{scene.path.name}: the bodies start {deepest:.3g} ({deepest / h:.2g} h) inside "
+                f"each other near {where}; the first load step pushes them apart."
+            ),
+            stacklevel=2,
+        )
+    return deepest
+
+
+__all__ = [
+    "SceneWarning",
+    "check_bodies_held",
+    "check_cells",
+    "check_initial_overlap",
+    "check_pair_surfaces",
+]
