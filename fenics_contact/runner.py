@@ -10,6 +10,7 @@ from mpi4py import MPI
 
 from fenics_contact.model.problem import ContactProblem
 from fenics_contact.output.checkpoint import CheckpointWriter, identity, read_latest, restore
+from fenics_contact.output.folders import agree, write_failure
 from fenics_contact.output.io import write_json
 from fenics_contact.output.xdmf import StepWriter
 from fenics_contact.scene.build import build_problem
@@ -69,6 +70,19 @@ def _summary(scene: Scene, record: RunRecord) -> dict:
     }
 
 
+def _write_summary(comm: MPI.Comm, out: Path, scene: Scene, record: RunRecord) -> dict:
+    """Write summary.json (rank 0); a failed write stops every process alike."""
+    summary = _summary(scene, record)
+    failure = None
+    if comm.rank == 0:
+        try:
+            write_json(out / "summary.json", summary)
+        except OSError as exc:
+            failure = write_failure(exc, out / "summary.json")
+    agree(comm, failure)
+    return summary
+
+
 def run_scene(
     scene: Scene,
     out: Path,
@@ -108,9 +122,9 @@ def run_scene(
     def finished(step: StepRecord) -> None:
         writer.write(step.load_factor)
         history = strategy.history if isinstance(strategy, Extrapolated) else []
-        checkpoint.write(step.step, [s.to_dict() for s in record.steps], history)
-        if comm.rank == 0:
-            write_json(out / "summary.json", _summary(scene, record))
+        checkpoint.write(step.step, [s.to_dict() for s in record.steps], history,
+                         files=writer.written)
+        _write_summary(comm, out, scene, record)
         if on_step is not None:
             on_step(step)
 
@@ -126,9 +140,7 @@ def run_scene(
         raise
     finally:
         writer.close()
-    summary = _summary(scene, path)
-    if comm.rank == 0:
-        write_json(out / "summary.json", summary)
+    summary = _write_summary(comm, out, scene, path)
     draw = scene.pictures if pictures is None else pictures
     if draw:
         from fenics_contact.output.pictures import deformed_contact_picture

@@ -186,9 +186,9 @@ def test_checkpoint_of_another_run_is_refused(scene, reference, tmp_path):
     before = (out / "solution.xdmf").read_text()
     text = scene.read_text()
     cases = {
-        "mesh": text.replace("cells = [8, 8, 4]", "cells = [8, 8, 5]"),
-        "method": text.replace('method = "gnrm"', 'method = "nua"'),
-        "load_steps": text.replace(f"steps = {STEPS}", "steps = 6"),
+        "mesh.cells": text.replace("cells = [8, 8, 4]", "cells = [8, 8, 5]"),
+        "solver.method": text.replace('method = "gnrm"', 'method = "nua"'),
+        "solver.steps": text.replace(f"steps = {STEPS}", "steps = 6"),
         "E": text.replace("E = 10.0", "E = 11.0"),
     }
     for key, changed in cases.items():

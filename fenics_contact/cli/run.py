@@ -77,11 +77,18 @@ def _run(args: argparse.Namespace) -> int:
 
         prepare_output_folder(out, MPI.COMM_WORLD)  # a bad --out ends here, before any mesh
         finished = [_checkpoint_step(out) if args.resume is not None else 0]
+        from fenics_contact.output.folders import OutputWriteError
+
         try:
             return _solve(args, scene, out, stop, finished)
         except StopRequested as exc:
             _stopped(exc, args, out, scene.solver.steps, finished[0])
             return exc.exit_code
+        except OutputWriteError as exc:
+            if MPI.COMM_WORLD.rank == 0:
+                print(f"fenics-contact: {exc}; the run stopped in load step {finished[0] + 1}; "
+                      f"{_kept(finished[0], out)}", file=sys.stderr, flush=True)
+            return 1
 
 
 def _solve(

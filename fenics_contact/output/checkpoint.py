@@ -14,18 +14,27 @@ leaves one complete checkpoint. The owned DOF coordinates are stored too:
 a resume checks them, so a changed mesh, order or partition is refused
 rather than read into the wrong places.
 
-What must match to resume (:func:`identity`): number of processes, method,
-load steps, body, material, conditions, obstacle and contact settings.
-Solver tolerances, iteration limits, cut-backs, predictor, linear solver,
-output fields and pictures may change (e.g. more iterations for a step
-that failed).
+What must match to resume (:func:`identity`): everything of the scene that
+changes the answer, taken from the scene's dataclasses as a whole (so a new
+scene key is covered without a word here): the number of processes, the
+method and load steps, the mesh (its parameters and the file's content), the
+bodies and their laws and constants, the conditions, obstacles, contact
+settings and pairs. Only what cannot change the answer may differ (e.g. more
+iterations for a step that failed): the scene's name and description, solver
+tolerances, iteration limits, cut-backs, predictor, linear solver, output
+fields and pictures. The step files named by the index are fingerprinted
+(size and SHA-256) in ``latest.json``, so a truncated or altered step file is
+named on resume instead of being continued.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import json
 import shutil
+import zipfile
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -33,11 +42,17 @@ import numpy as np
 from dolfinx import fem
 
 from fenics_contact.model.problem import ContactProblem
+from fenics_contact.output.folders import agree, write_failure
 from fenics_contact.output.io import _clean, write_json
 from fenics_contact.scene.schema import Scene
 
 #: Checkpoint layout version; a reader refuses others.
-FORMAT = 1
+FORMAT = 2
+#: Scene fields that cannot change the answer (a resume may change them).
+_FREE_SCENE_KEYS = frozenset({"path", "name", "description", "fields", "pictures"})
+#: Solver settings that change the answer; the others (tolerances, limits, predictor,
+#: linear solver) may change on resume.
+_ANSWER_SOLVER_KEYS = ("method", "steps")
 LATEST = "latest.json"
 _KEYS = {
     "u", "lam", "load_factor", "history_t", "history_u", "history_lam", "u_coordinates",
@@ -67,23 +82,42 @@ class Checkpoint:
     history: list[tuple[float, np.ndarray, np.ndarray]]
 
 
+def _file_digest(path: Path) -> str:
+    """SHA-256 of a file's content (hex)."""
+    digest = hashlib.sha256()
+    with path.open("rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
 def identity(scene: Scene, processes: int) -> dict:
-    """What a checkpoint must share with the scene that resumes it (JSON-safe)."""
-    return _json_roundtrip({
-        "format": FORMAT,
-        "processes": processes,
-        "method": scene.solver.method,
-        "load_steps": scene.solver.steps,
-        "dimension": scene.dimension,
-        "mesh": dataclasses.asdict(scene.mesh),
-        "law": scene.law,
-        "E": scene.E,
-        "nu": scene.nu,
-        "dirichlet": [dataclasses.asdict(b) for b in scene.dirichlet],
-        "tractions": [dataclasses.asdict(b) for b in scene.tractions],
-        "obstacle": dataclasses.asdict(scene.obstacle),
-        "contact": dataclasses.asdict(scene.contact),
-    })
+    """What a checkpoint must share with the scene that resumes it (JSON-safe).
+
+    The whole scene but the keys in ``_FREE_SCENE_KEYS`` and the solver
+    settings outside ``_ANSWER_SOLVER_KEYS``, plus the process count and the
+    content of the mesh file.
+    """
+    data = {k: v for k, v in dataclasses.asdict(scene).items() if k not in _FREE_SCENE_KEYS}
+    data["solver"] = {k: data["solver"][k] for k in _ANSWER_SOLVER_KEYS}
+    mesh_file = scene.mesh.file
+    if mesh_file is not None and mesh_file.is_file():
+        data["mesh_file_sha256"] = _file_digest(mesh_file)
+    return _json_roundtrip({"format": FORMAT, "processes": processes, **data})
+
+
+def _flat(value: object, prefix: str = "") -> dict[str, object]:
+    """Nested dicts and lists as {'bodies[1].E': 100.0, ...}, for naming differences."""
+    if isinstance(value, dict):
+        items = [(f"{prefix}.{k}" if prefix else str(k), v) for k, v in value.items()]
+    elif isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+        items = [(f"{prefix}[{i}]", v) for i, v in enumerate(value)]
+    else:
+        return {prefix: value}
+    out: dict[str, object] = {}
+    for key, item in items:
+        out.update(_flat(item, key))
+    return out
 
 
 def _json_roundtrip(data: dict) -> dict:
@@ -109,7 +143,10 @@ def read_latest(folder: Path, expected: dict) -> dict:
         saved = marker["identity"]
     except (OSError, ValueError, KeyError, TypeError) as exc:
         raise CheckpointError(f"Checkpoint {latest} is damaged ({exc}); start afresh.") from exc
-    expected = _json_roundtrip(expected)
+    if not isinstance(saved, dict):
+        raise CheckpointError(f"Checkpoint {latest} is damaged (no identity); start afresh.")
+    expected = _flat(_json_roundtrip(expected))
+    saved = _flat(saved)
     differ = [
         f"{key}: checkpoint {saved.get(key)!r}, now {expected.get(key)!r}"
         for key in sorted(set(saved) | set(expected))
@@ -121,7 +158,26 @@ def read_latest(folder: Path, expected: dict) -> dict:
             f"resumed by this one ({'; '.join(differ)}). Resume with the scene and number "
             "of processes that wrote it, or run without --resume to start afresh."
         )
+    _check_files(folder.parent, marker.get("files", {}))
     return marker
+
+
+def _check_files(out: Path, files: dict) -> None:
+    """Every output file the checkpoint fingerprinted is there, whole and unchanged."""
+    for name, (size, digest) in files.items():
+        path = out / name
+        if not path.is_file():
+            why = "is missing"
+        elif path.stat().st_size != size:
+            why = f"has {path.stat().st_size} bytes instead of {size} (truncated or rewritten)"
+        elif _file_digest(path) != digest:
+            why = "changed since the step was written (its content differs)"
+        else:
+            continue
+        raise CheckpointError(
+            f"Output file {path} {why}; the finished steps cannot be continued. "
+            "Run without --resume to start afresh."
+        )
 
 
 def _owned(f: fem.Function) -> np.ndarray:
@@ -164,40 +220,64 @@ class CheckpointWriter:
             "u_coordinates": _owned_coordinates(problem.u),
             "lam_coordinates": _owned_coordinates(problem.lam),
         }
+        #: Fingerprints [size, sha256] of the finished steps' files, by path in the run folder.
+        self._files: dict[str, list] = {}
+        latest = folder / LATEST
+        if not fresh and comm.rank == 0 and latest.is_file():
+            self._files = dict(json.loads(latest.read_text()).get("files", {}))
 
     def write(
         self,
         step: int,
         records: list[dict],
         history: list[tuple[float, np.ndarray, np.ndarray]] = (),  # type: ignore[assignment]
+        files: Sequence[Path] = (),
     ) -> None:
-        """Save the state after load step ``step`` (records: steps 1 .. step)."""
+        """Save the state after load step ``step`` (records: steps 1 .. step).
+
+        ``files``: output files (closed) that a resume must find unchanged;
+        their sizes and SHA-256 go into ``latest.json``.
+        """
         p = self.problem
         comm = p.comm
         path = _rank_file(self.folder, step, comm.rank)
-        path.parent.mkdir(parents=True, exist_ok=True)
         nu, nl = _owned(p.u).size, _owned(p.lam).size
-        np.savez(
-            path,
-            u=_owned(p.u),
-            lam=_owned(p.lam),
-            load_factor=np.float64(p.load_factor),
-            history_t=np.array([h[0] for h in history], dtype=np.float64),
-            history_u=np.array([h[1][:nu] for h in history]).reshape(len(history), nu),
-            history_lam=np.array([h[2][:nl] for h in history]).reshape(len(history), nl),
-            **self._coordinates,
-        )
-        comm.Barrier()  # every process's file is complete
+        failure = None
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            np.savez(
+                path,
+                u=_owned(p.u),
+                lam=_owned(p.lam),
+                load_factor=np.float64(p.load_factor),
+                history_t=np.array([h[0] for h in history], dtype=np.float64),
+                history_u=np.array([h[1][:nu] for h in history]).reshape(len(history), nu),
+                history_lam=np.array([h[2][:nl] for h in history]).reshape(len(history), nl),
+                **self._coordinates,
+            )
+        except OSError as exc:
+            failure = write_failure(exc, path)
+        agree(comm, failure)  # every process's file is complete
         if comm.rank == 0:
-            write_json(self.folder / LATEST, {
-                "step": step,
-                "load_factor": p.load_factor,
-                "identity": self.identity,
-                "records": records,
-            })
-            for old in self.folder.glob("step_*"):
-                if old.name != f"step_{step:04d}":
-                    shutil.rmtree(old, ignore_errors=True)
+            try:
+                for f in files:
+                    self._files[str(f.relative_to(self.folder.parent))] = [
+                        f.stat().st_size, _file_digest(f)
+                    ]
+                write_json(self.folder / LATEST, {
+                    "step": step,
+                    "load_factor": p.load_factor,
+                    "identity": self.identity,
+                    "records": records,
+                    "files": self._files,
+                })
+            except OSError as exc:
+                failure = write_failure(exc, self.folder / LATEST)
+            else:
+                for old in self.folder.glob("step_*"):
+                    if old.name != f"step_{step:04d}":
+                        shutil.rmtree(old, ignore_errors=True)
+        agree(comm, failure)
 
 
 def _full(f: fem.Function, owned: np.ndarray) -> np.ndarray:
@@ -222,8 +302,8 @@ def restore(folder: Path, problem: ContactProblem, marker: dict) -> Checkpoint:
     try:
         with np.load(path) as npz:
             data = {k: npz[k] for k in npz.files}
-    except (OSError, ValueError, EOFError) as exc:
-        problem_here = f"process {comm.rank}: {path} unreadable ({exc})"
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+        problem_here = f"process {comm.rank}: {path} is damaged or unreadable ({exc})"
     missing = sorted(_KEYS - set(data))
     if problem_here is None and missing:
         problem_here = f"process {comm.rank}: {path} lacks {missing}"

@@ -54,3 +54,30 @@ def _prepare(out: Path) -> Path:
             "choose a writable --out."
         ) from None
     return out
+
+
+class OutputWriteError(RuntimeError):
+    """A file of the run's output could not be written (disk full, folder removed, read-only).
+
+    Raised on every process alike (see :func:`agree`); the message names the
+    file and the operating system's reason.
+    """
+
+
+def write_failure(exc: BaseException, path: Path) -> str:
+    """One line naming the file a write failed on and why (``path`` when the error names none)."""
+    name = getattr(exc, "filename", None) or path
+    reason = getattr(exc, "strerror", None) or " ".join(str(exc).split()) or type(exc).__name__
+    return f"cannot write {name} ({reason})"
+
+
+def agree(comm, failure: str | None) -> None:
+    """Collective: raise :class:`OutputWriteError` on every process when one of them failed.
+
+    Stands where a barrier would: every process reaches it after its share of
+    a write, so a failure on one process stops them all at the same point
+    instead of leaving the others waiting in the next collective call.
+    """
+    failures = [f for f in comm.allgather(failure) if f]
+    if failures:
+        raise OutputWriteError(failures[0])

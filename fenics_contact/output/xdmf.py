@@ -18,6 +18,7 @@ the new one, and every step an index names is complete on disk.
 from __future__ import annotations
 
 import copy
+import errno
 import os
 import re
 from collections.abc import Sequence
@@ -29,6 +30,7 @@ from dolfinx import fem, io
 
 from fenics_contact.model.materials import von_mises
 from fenics_contact.model.problem import ContactProblem
+from fenics_contact.output.folders import agree, write_failure
 from fenics_contact.output.io import SurfaceToBody
 from fenics_contact.scene.schema import FIELDS, FRICTION_FIELDS
 
@@ -231,30 +233,47 @@ class StepWriter:
             surface["stick_slip"] = state.node_state.astype(float)  # type: ignore[attr-defined]
             vectors = {"tangential_traction": traction, "slip": slip}
         step_xdmf = self.folder / f"{_step_name(self.step)}.xdmf"
-        with io.XDMFFile(p.comm, str(step_xdmf), "w") as file:
-            file.write_mesh(p.domain)
-            for name in self.fields:
-                if name == "displacement":
-                    file.write_function(p.u, t)
-                elif name == "von_mises":
-                    assert self._stress is not None
-                    for expr, cells in self._stress_exprs:
-                        if cells is None:
-                            self._stress.interpolate(expr)
-                        else:
-                            self._stress.interpolate(expr, cells0=cells)
-                    file.write_function(self._stress, t)
-                elif name in vectors:
-                    file.write_function(self._surface_vector(name, vectors[name]), t)
-                else:
-                    file.write_function(self._surface_field(name, surface[name]), t)
-            if self._body_id is not None:
-                file.write_function(self._body_id, t)
-                file.write_function(p.target_force(), t)
-        p.comm.Barrier()  # every rank's part of the HDF5 file is written and closed
+        failure = None
+        try:
+            with io.XDMFFile(p.comm, str(step_xdmf), "w") as file:
+                file.write_mesh(p.domain)
+                for name in self.fields:
+                    if name == "displacement":
+                        file.write_function(p.u, t)
+                    elif name == "von_mises":
+                        assert self._stress is not None
+                        for expr, cells in self._stress_exprs:
+                            if cells is None:
+                                self._stress.interpolate(expr)
+                            else:
+                                self._stress.interpolate(expr, cells0=cells)
+                        file.write_function(self._stress, t)
+                    elif name in vectors:
+                        file.write_function(self._surface_vector(name, vectors[name]), t)
+                    else:
+                        file.write_function(self._surface_field(name, surface[name]), t)
+                if self._body_id is not None:
+                    file.write_function(self._body_id, t)
+                    file.write_function(p.target_force(), t)
+        except (OSError, RuntimeError) as exc:  # HDF5 errors reach Python as RuntimeError
+            failure = write_failure(exc, step_xdmf.with_suffix(".h5"))
+        agree(p.comm, failure)  # every rank's part of the HDF5 file is written and closed
         if p.comm.rank == 0:
-            self._grids.append(step_grid(step_xdmf, self.path))
-            write_index(self.path, self._grids)
+            gone = [k for k in range(1, self.step)
+                    if not (self.folder / f"{_step_name(k)}.h5").is_file()]
+            try:
+                if gone:  # the folder was removed or emptied while the run went on
+                    raise FileNotFoundError(
+                        errno.ENOENT, f"the files of step(s) {gone} were removed during the run",
+                        str(self.path),
+                    )
+                self._grids.append(step_grid(step_xdmf, self.path))
+                write_index(self.path, self._grids)
+            except OSError as exc:
+                failure = write_failure(exc, self.path)
+        agree(p.comm, failure)
+        #: The files of the step just written (closed).
+        self.written = (step_xdmf, step_xdmf.with_suffix(".h5"))
         self.step += 1
 
     def close(self) -> None:
