@@ -215,3 +215,61 @@ def test_checkpoint_of_another_run_is_refused(scene, reference, tmp_path):
     )
     assert done.returncode == 2 and "No checkpoint in" in done.stderr
     assert (out / "solution.xdmf").read_text() == before  # a refused resume writes nothing
+
+
+def _rank_pids(launcher_pid: int) -> list[int]:
+    """Process ids of the Python ranks below an mpiexec (its descendants running this CLI)."""
+    children: dict[int, list[int]] = {}
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        children.setdefault(int(fields[1]), []).append(int(stat.parent.name))
+    found, todo = [], [launcher_pid]
+    while todo:
+        pid = todo.pop()
+        for child in children.get(pid, []):
+            todo.append(child)
+            try:
+                cmdline = (Path("/proc") / str(child) / "cmdline").read_bytes()
+            except OSError:
+                continue
+            if b"fenics_contact.cli" in cmdline:
+                found.append(child)
+    return sorted(found)
+
+
+@pytest.mark.skipif(MPIEXEC is None, reason="needs mpiexec")
+def test_one_killed_rank_stops_the_others(scene, reference, tmp_path):
+    """SIGKILL one of two ranks: the other must not hang in a collective call.
+
+    MPICH's mpiexec ends the remaining ranks when one dies; the bound below is
+    a guard against a hang, not a timing measurement.
+    """
+    out = tmp_path / "rank-killed"
+    proc = subprocess.Popen(
+        command("run", scene, "--out", out, "--quiet", "--no-pictures", processes=2),
+        env=ENV, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )
+    deadline = time.monotonic() + 300
+    while finished_steps(out) < 3:
+        assert proc.poll() is None, proc.communicate()[1]
+        assert time.monotonic() < deadline
+        time.sleep(0.02)
+    ranks = _rank_pids(proc.pid)
+    assert len(ranks) == 2, ranks
+    os.kill(ranks[-1], signal.SIGKILL)
+    try:
+        proc.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.communicate()
+        pytest.fail("the surviving rank hung after its partner was killed")
+    assert proc.returncode != 0
+    for pid in ranks:  # no orphaned rank left running
+        assert not Path(f"/proc/{pid}").exists() or "Z" in Path(
+            f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    on_disk = len(read(out)["meshio"])
+    assert 3 <= on_disk < STEPS
+    assert_readable_steps(out, reference, on_disk)
