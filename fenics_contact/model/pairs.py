@@ -23,6 +23,7 @@ facet. The solver condenses the w_k onto u with the selection w_k = S_k u
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -46,7 +47,7 @@ from fenics_contact.model.problem import (
     SurfaceTraction,
     energy_quadrature_degree,
 )
-from fenics_contact.model.search import SurfaceSearch
+from fenics_contact.model.search import SurfaceSearch, penetration_depth
 
 
 @dataclass(frozen=True)
@@ -276,6 +277,17 @@ class DeformablePair:
             self.version += 1
         return changed
 
+    def penetration(self) -> np.ndarray:
+        """Depth of each owned striker node inside the current target surface (length, >= 0).
+
+        Measured to the closest point of the whole target surface (collective:
+        the target surface is gathered), not to the plane of the assigned
+        facet: a node left on the extension of a facet it has passed can lie
+        inside the real surface while its gap to that plane is positive.
+        """
+        current = (self.X_vertices + self.target_displacements())[self.facet_vertex]
+        return penetration_depth(self.striker_positions()[: self.n_owned], current)
+
     def sources(self) -> list[np.ndarray]:
         """Global V block index that each owned W block selects, one array per vertex k.
 
@@ -500,9 +512,19 @@ class TwoBodyProblem(ContactProblem):
         self.pair.refresh()
 
     def contact_state(self) -> ContactState:
-        """Nodal gaps, pressures and global summaries at the current u (fresh search)."""
+        """Nodal gaps, pressures and global summaries at the current u (fresh search).
+
+        The max penetration is measured against the actual target surface
+        (:meth:`DeformablePair.penetration`), so the Signorini check and the
+        report see a node that sits inside the target past the end of its facet.
+        """
         self.pair.refresh()
-        return super().contact_state()
+        state = super().contact_state()
+        depth = self.pair.penetration()
+        deepest = self.comm.allreduce(float(np.max(depth, initial=0.0)), op=MPI.MAX)
+        return dataclasses.replace(
+            state, max_penetration=deepest, constraint_penetration=state.max_penetration
+        )
 
     def active_signature(self) -> tuple[bytes, ...]:
         """Fingerprint of the active set at the current u (fresh search)."""

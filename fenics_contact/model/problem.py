@@ -191,6 +191,10 @@ class ContactState:
             round-off of r g that p carries at huge r (at r = 1e12 E/h a gap
             of 1e-15 makes r g of order one). The penalty method, whose
             multiplier is zero, reports -int r min(g, 0) dA.
+        constraint_penetration: two deformable bodies: the max penetration by
+            the discretisation's own gap (to the plane of each node's assigned
+            facet), while ``max_penetration`` is the depth inside the actual
+            target surface; None where the two are one (rigid obstacles).
     """
 
     gap: np.ndarray
@@ -200,6 +204,7 @@ class ContactState:
     active_count: int
     max_penetration: float
     contact_force: float
+    constraint_penetration: float | None = None
 
     @classmethod
     def gathered(

@@ -198,3 +198,66 @@ class SurfaceSearch:
         j = np.argmin(key, axis=1)
         rows = np.arange(points.shape[0])
         return idx[rows, j], xi[rows, j], dist[rows, j], over[rows, j]
+
+
+def facet_normals(vertices: np.ndarray) -> np.ndarray:
+    """Unit normals of oriented facets (m, nv, gdim): segments (t_y, -t_x), triangles e1 x e2."""
+    if vertices.shape[2] == 2:
+        t = vertices[:, 1] - vertices[:, 0]
+        n = np.stack([t[:, 1], -t[:, 0]], axis=-1)
+    else:
+        n = np.cross(vertices[:, 1] - vertices[:, 0], vertices[:, 2] - vertices[:, 0])
+    return n / np.linalg.norm(n, axis=-1, keepdims=True)
+
+
+def _closest_points(points: np.ndarray, facets: np.ndarray) -> np.ndarray:
+    """Closest point of each facet (n, nv, gdim) to each point (n, gdim), clamped to the facet."""
+    a = facets[:, 0]
+    if facets.shape[1] == 2:
+        t = facets[:, 1] - a
+        xi = np.clip(np.einsum("ij,ij->i", points - a, t) / np.einsum("ij,ij->i", t, t), 0, 1)
+        return a + xi[:, None] * t
+    xi, dist, over = project(points, facets[:, None])
+    st, dist, over = xi[:, 0], dist[:, 0], over[:, 0]
+    inside = a + st[:, :1] * (facets[:, 1] - a) + st[:, 1:] * (facets[:, 2] - a)
+    best, best_d = inside.copy(), np.where(over == 0.0, dist, np.inf)
+    for q0, q1 in ((0, 1), (1, 2), (2, 0)):
+        c = _closest_points(points, facets[:, [q0, q1]])
+        d = np.linalg.norm(points - c, axis=-1)
+        closer = d < best_d
+        best[closer], best_d[closer] = c[closer], d[closer]
+    return best
+
+
+def penetration_depth(points: np.ndarray, vertices: np.ndarray, candidates: int = 8) -> np.ndarray:
+    """How deep each point lies inside an oriented surface, by closest point (length; 0 outside).
+
+    The actual surface, not the plane of an assigned facet: the closest point
+    over all facets, and the side from the pseudo-normal (the sum of the
+    normals of every facet that shares that closest point), which is right at
+    edges and vertices where one facet's plane is not. Points whose closest
+    point lies on a free edge of the surface count as outside.
+
+    Args:
+        points: (n, gdim) positions.
+        vertices: (m, nv, gdim) facet vertices, ordered so the normals point outward.
+        candidates: nearest facets (by centroid) examined per point.
+    """
+    points = np.asarray(points, float)
+    if points.shape[0] == 0:
+        return np.zeros(0)
+    search = SurfaceSearch(vertices, candidates)
+    nearest = search.closest(points)
+    k = min(max(candidates, 2 * points.shape[1]), vertices.shape[0])
+    _, idx = search.tree.query(points, k=k)
+    idx = np.asarray(idx).reshape(points.shape[0], -1)
+    idx[:, 0] = nearest.facet  # the closest facet is always among the candidates
+    _, dist, _ = project(points, vertices[idx])
+    ties = dist <= nearest.distance[:, None] + TIE_TOL * search.size
+    pseudo = np.einsum("ij,ijk->ik", ties.astype(float), facet_normals(vertices)[idx])
+    closest = _closest_points(points, vertices[nearest.facet])
+    behind = np.einsum("ij,ij->i", points - closest, pseudo) < 0.0
+    # past a free edge of the surface (the closest point on one facet only, at its
+    # boundary) no side is defined: the body's other faces are there, not this surface
+    on_surface = (nearest.overshoot == 0.0) | (ties.sum(axis=1) > 1)
+    return np.where(behind & on_surface, nearest.distance, 0.0)
