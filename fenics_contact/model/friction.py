@@ -101,6 +101,39 @@ def tangent_basis(n: ufl.core.expr.Expr, gdim: int) -> ufl.core.expr.Expr:
     return ufl.as_matrix([[t1[i], t2[i]] for i in range(3)])
 
 
+def symmetry_planes(
+    domain: mesh.Mesh, conditions: Sequence[object]
+) -> list[tuple[np.ndarray, int]]:
+    """(facets, axis) of each Dirichlet condition that is a symmetry plane (collective).
+
+    A condition is one when it holds exactly one displacement component at 0
+    (the others free) on facets that all lie in one plane normal to that
+    component's axis, e.g. u_y = 0 on the face y = 0 of a half model.
+    """
+    x = domain.geometry.x
+    fdim = domain.topology.dim - 1
+    comm = domain.comm
+    span = comm.allreduce(float(np.ptp(x, axis=0).max(initial=0.0)) if x.size else 0.0,
+                          op=MPI.MAX) or 1.0
+    planes = []
+    for condition in conditions:
+        if getattr(condition, "path", ()):
+            continue
+        value = condition.value  # type: ignore[attr-defined]
+        held = [i for i, v in enumerate(value) if v is not None]
+        if len(held) != 1 or value[held[0]] != 0.0:
+            continue
+        axis = held[0]
+        facets = np.asarray(condition.facets, dtype=np.int32)  # type: ignore[attr-defined]
+        nodes = mesh.entities_to_geometry(domain, fdim, facets).ravel() if facets.size else []
+        coords = x[nodes, axis] if len(nodes) else np.zeros(0)
+        lo = comm.allreduce(float(np.min(coords, initial=np.inf)), op=MPI.MIN)
+        hi = comm.allreduce(float(np.max(coords, initial=-np.inf)), op=MPI.MAX)
+        if np.isfinite(lo) and hi - lo <= 1e-12 * span:
+            planes.append((facets, axis))
+    return planes
+
+
 def coulomb_projection(
     y: ufl.core.expr.Expr, rho: ufl.core.expr.Expr, eps: ufl.core.expr.Expr
 ) -> ufl.core.expr.Expr:
@@ -223,6 +256,11 @@ class FrictionMixin:
             lam_t = self.lam_t
         self.u_prev = fem.Function(self.V, name="displacement_prev")
         self.tangents, self.slip = self._slip_increment()
+        #: 1 per tangential component, 0 where a symmetry plane through the contact
+        #: zone makes the traction's component across the plane vanish.
+        self.symmetry_mask = fem.Function(self.Qt, name="symmetry_mask")
+        self.symmetry_mask.x.array[:] = 1.0
+        mask = ufl.as_vector([self.symmetry_mask]) if gdim == 2 else self.symmetry_mask
         #: Extent L of the candidate contact surface (length).
         self.contact_extent = surface_extent(self.surface.submesh)
         #: Tangential parameter r_t = min(r, r_t_cap), r_t_cap = tangential_r_max E/L
@@ -235,12 +273,14 @@ class FrictionMixin:
         self.r_t: ufl.core.expr.Expr = ufl.min_value(self.r, self.r_t_cap)
         self.trial_traction = lam_t + self.r_t * self.slip
         self.coulomb_radius = -self.mu * self.pressure
-        self.traction_t = coulomb_projection(self.trial_traction, self.coulomb_radius, self.eps)
+        self.traction_t = ufl.elem_mult(
+            mask, coulomb_projection(self.trial_traction, self.coulomb_radius, self.eps)
+        )
         self._lam_t_vector = lam_t
         # penalty: regularised stick on the committed traction, rho = mu r max(-g, 0)
         self._penalty_radius = -self.mu * ufl.min_value(self.r * self.gap, 0.0)
-        self.penalty_traction = coulomb_projection(
-            self.trial_traction, self._penalty_radius, self.eps
+        self.penalty_traction = ufl.elem_mult(
+            mask, coulomb_projection(self.trial_traction, self._penalty_radius, self.eps)
         )
 
         k = gdim - 1
@@ -263,6 +303,56 @@ class FrictionMixin:
             ufl.sqrt(ufl.dot(self.traction_t, self.traction_t)) * self.surface.ds,
             entity_maps=self.surface.entity_maps,
         )
+        self.symmetry_constraints = self._constrain_symmetry_planes()
+
+    def _constrain_symmetry_planes(self) -> int:
+        """Zero the traction across every symmetry plane at the contact nodes it holds.
+
+        A symmetry plane is a Dirichlet condition holding one displacement
+        component at 0 on a plane of facets normal to that axis (see
+        :func:`symmetry_planes`). At a contact node on it the slip across the
+        plane vanishes identically, so a sticking node would leave the
+        tangential multiplier's component across the plane undetermined (a
+        singular Jacobian); by symmetry that traction component is zero, and
+        :attr:`symmetry_mask` makes it so (residual row lam_t,k = 0, no force).
+        The frame component along the plane's normal is found from the nodal
+        tangents; a frame not aligned with the plane is refused. Returns the
+        number of constrained (node, component) pairs (global).
+        """
+        conditions = [c for _, c, _ in getattr(self, "_bc_constants", [])]
+        planes = symmetry_planes(self.domain, conditions)
+        if not planes:
+            return 0
+        fdim = self.domain.topology.dim - 1
+        W = fem.functionspace(self.domain, ("Lagrange", 1))
+        parent = self.surface.parent_dofs(W)
+        n_owned = self.Q.dofmap.index_map.size_local
+        k = self.gdim - 1
+        self.refresh_search()  # type: ignore[attr-defined]
+        frame = np.stack([
+            np.column_stack([self.surface.nodal(self.surface.nodal_form(self.tangents[i, j]))
+                             for j in range(k)])
+            for i in range(self.gdim)
+        ], axis=1)  # (owned nodes, gdim, d-1)
+        count = 0
+        for facets, axis in planes:
+            held = fem.locate_dofs_topological(W, fdim, facets)
+            nodes = np.flatnonzero(np.isin(parent[:n_owned], held))
+            along = np.abs(frame[nodes, axis, :])
+            j = np.argmax(along, axis=1) if nodes.size else np.zeros(0, int)
+            worst = float(np.min(along[np.arange(nodes.size), j], initial=1.0))
+            worst = self.comm.allreduce(worst, op=MPI.MIN)
+            if worst < 1.0 - 1e-8:
+                raise ValueError(
+                    f"A symmetry plane (u_{'xyz'[axis]} = 0 on a plane normal to "
+                    f"{'xyz'[axis]}) crosses the frictional contact surface where the contact "
+                    f"normal is not in the plane (|t . e_{'xyz'[axis]}| = {worst:.3g}); a "
+                    "symmetry cut needs the contact normal in the plane there."
+                )
+            self.symmetry_mask.x.array[nodes * k + j] = 0.0
+            count += self.comm.allreduce(int(nodes.size), op=MPI.SUM)
+        self.symmetry_mask.x.scatter_forward()
+        return count
 
     def _slip_increment(self) -> tuple[ufl.core.expr.Expr, ufl.core.expr.Expr]:
         """(T, dg_t): the gdim x (d-1) tangent matrix and the slip increment (length)."""

@@ -173,6 +173,9 @@ class NewtonKernel:
             with stopwatch(t, "solve_s"):
                 self.ksp.solve(self.b, self.dx)
         except PETSc.Error:
+            # A solve that stops with an error (e.g. a singular factorisation) leaves
+            # b locked read-only: the next assembly into it would fail ("error code 73").
+            self.b = self.b.duplicate()
             return False
         self.linear_solves += 1
         t.linear_solves += 1
