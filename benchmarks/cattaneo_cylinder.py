@@ -22,11 +22,8 @@ import harness
 from cattaneo_plot import traction_picture
 
 import fenics_contact  # noqa: F401  (before dolfinx)
-from fenics_contact.verification.cattaneo import (
-    CattaneoCylinder,
-    contact_profile,
-    solve_cattaneo,
-)
+from fenics_contact.studies.cattaneo import solve_cattaneo
+from fenics_contact.verification.cattaneo import CattaneoCylinder, contact_profile
 
 CASES = [  # (nu, h_contact, degree, frictionless pressing)
     (0.3, 0.004, 1, True), (0.45, 0.004, 1, True), (0.49, 0.004, 1, True),

@@ -31,10 +31,7 @@ from cattaneo_plot import traction_picture
 
 import fenics_contact  # noqa: F401  (before dolfinx)
 from fenics_contact.scene.schema import MeshSpec, load_scene
-from fenics_contact.verification.cattaneo import (
-    pressing_check,
-    solve_cattaneo_mindlin,
-)
+from fenics_contact.studies.cattaneo import pressing_check, solve_cattaneo_mindlin
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "scenes" / "cattaneo_mindlin.toml"

@@ -14,12 +14,8 @@ import pytest
 
 from fenics_contact.cli import main
 from fenics_contact.scene.schema import load_scene
-from fenics_contact.verification.cattaneo import (
-    pressing_check,
-    shear_start,
-    solve_cattaneo_mindlin,
-    two_cylinders_hertz,
-)
+from fenics_contact.studies.cattaneo import pressing_check, shear_start, solve_cattaneo_mindlin
+from fenics_contact.verification.cattaneo import two_cylinders_hertz
 
 SCENE = Path(__file__).parent.parent / "scenes" / "cattaneo_mindlin.toml"
 MU = 0.3

@@ -292,7 +292,8 @@ def test_obstacle_follows_its_schedule():
 
 def test_cattaneo_mindlin_stick_zone_of_a_cylinder_on_a_rigid_plane():
     """Interim check (beta = 0.09, frictionless pressing): c = a sqrt(1 - Q/(mu P))."""
-    from fenics_contact.verification.cattaneo import CattaneoCylinder, solve_cattaneo
+    from fenics_contact.studies.cattaneo import solve_cattaneo
+    from fenics_contact.verification.cattaneo import CattaneoCylinder
 
     _, zones, iterations = solve_cattaneo(
         CattaneoCylinder(shift=0.003), press_steps=2, shear_steps=4

@@ -13,8 +13,8 @@ def _stability(args: argparse.Namespace) -> int:
     from mpi4py import MPI
 
     from fenics_contact.output.io import write_csv, write_json
-    from fenics_contact.output.sweep_plots import stability_plot
     from fenics_contact.studies.stability import ERROR, full_grid, run_grid, select
+    from fenics_contact.studies.sweep_plots import stability_plot
 
     out: Path = args.out
     rank0 = MPI.COMM_WORLD.rank == 0

@@ -13,7 +13,7 @@ def _tradeoff(args: argparse.Namespace) -> int:
     from mpi4py import MPI
 
     from fenics_contact.output.io import write_csv, write_json
-    from fenics_contact.output.sweep_plots import tradeoff_plot
+    from fenics_contact.studies.sweep_plots import tradeoff_plot
     from fenics_contact.studies.tradeoff import markdown_table, run_tradeoff
 
     out: Path = args.out

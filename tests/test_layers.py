@@ -1,0 +1,69 @@
+"""The package's layers, as the README states them: no module imports a layer above its own.
+
+Every ``import`` and ``from ... import`` of every module is read with ``ast``
+(those inside functions and ``TYPE_CHECKING`` blocks too: a lazy import is
+still a dependency).
+"""
+
+import ast
+from pathlib import Path
+
+import pytest
+
+PACKAGE = Path(__file__).parent.parent / "fenics_contact"
+
+#: What each layer may import besides itself (the README's "What may import what").
+#: Layers not named here (studies, cli, runner, the package's top-level modules) may
+#: import anything.
+ALLOWED = {
+    "model": set(),
+    "solvers": {"model"},
+    "scene": {"model", "solvers"},
+    "output": {"model", "solvers", "scene"},
+    "verification": {"model", "scene"},
+}
+
+
+def violations(package: Path) -> list[str]:
+    """'module -> imported (line)' for every import against :data:`ALLOWED`."""
+    name = package.name
+    found = []
+    for path in sorted(package.rglob("*.py")):
+        parts = path.relative_to(package).with_suffix("").parts
+        if len(parts) < 2 or parts[0] not in ALLOWED:
+            continue
+        layer = parts[0]
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            if isinstance(node, ast.ImportFrom) and node.level:
+                raise AssertionError(f"{path}: relative import; write the absolute one")
+            targets = (
+                [node.module] if isinstance(node, ast.ImportFrom) and node.module
+                else [a.name for a in node.names] if isinstance(node, ast.Import) else []
+            )
+            for target in targets:
+                pieces = target.split(".")
+                if pieces[0] != name:
+                    continue
+                other = pieces[1] if len(pieces) > 1 else "(package)"
+                if other != layer and other not in ALLOWED[layer]:
+                    found.append(f"{name}.{'.'.join(parts)} -> {target} (line {node.lineno})")
+    return found
+
+
+def test_no_module_imports_against_the_layers():
+    assert violations(PACKAGE) == []
+
+
+@pytest.mark.parametrize(("layer", "source", "caught"), [
+    ("model", "from pkg.solvers.newton import NewtonKernel\n", True),
+    ("output", "def f():\n    import pkg.studies.tradeoff\n", True),
+    ("verification", "from pkg.solvers import make_strategy\n", True),
+    ("scene", "import pkg\n", True),
+    ("output", "from pkg.scene.schema import FIELDS\n", False),
+])
+def test_the_check_finds_an_upward_import(tmp_path, layer, source, caught):
+    """The checker itself, on a small package: it must be able to fail."""
+    package = tmp_path / "pkg"
+    (package / layer).mkdir(parents=True)
+    (package / layer / "bad.py").write_text(source)
+    assert bool(violations(package)) == caught
