@@ -27,52 +27,48 @@ schema, meshes, building) and ``output`` (XDMF, JSON, pictures),
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
-
 try:  # the wheel build of DOLFINx must be imported before dolfinx/petsc4py
     import dolfinx_solver  # noqa: F401
 except ImportError:  # DOLFINx installed otherwise (official images)
     pass
 
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.model.materials import material
+from fenics_contact.model.obstacles import RigidBall, RigidPlane
+from fenics_contact.model.problem import (
+    ContactProblem,
+    PrescribedDisplacement,
+    SurfaceTraction,
+)
+from fenics_contact.runner import run_scene
+from fenics_contact.scene.build import build_problem
+from fenics_contact.scene.schema import Scene, SceneError, load_scene
+from fenics_contact.solvers import STRATEGIES, make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings, Status
+from fenics_contact.solvers.linear import LinearSolverSettings
+from fenics_contact.solvers.stepping import RunRecord, StepRecord, solve_load_path
+
 __version__ = "0.1.0"
 
-#: Public names and the modules that define them (imported on first use, so
-#: that ``import fenics_contact`` stays cheap).
-_PUBLIC = {
-    "load_scene": "fenics_contact.scene.schema",
-    "Scene": "fenics_contact.scene.schema",
-    "SceneError": "fenics_contact.scene.schema",
-    "build_problem": "fenics_contact.scene.build",
-    "ContactProblem": "fenics_contact.model.problem",
-    "PrescribedDisplacement": "fenics_contact.model.problem",
-    "SurfaceTraction": "fenics_contact.model.problem",
-    "ContactSettings": "fenics_contact.model.contact",
-    "material": "fenics_contact.model.materials",
-    "RigidPlane": "fenics_contact.model.obstacles",
-    "RigidBall": "fenics_contact.model.obstacles",
-    "SolverSettings": "fenics_contact.solvers.diagnostics",
-    "Status": "fenics_contact.solvers.diagnostics",
-    "LinearSolverSettings": "fenics_contact.solvers.linear",
-    "make_strategy": "fenics_contact.solvers",
-    "STRATEGIES": "fenics_contact.solvers",
-    "solve_load_path": "fenics_contact.solvers.stepping",
-    "RunRecord": "fenics_contact.solvers.stepping",
-    "StepRecord": "fenics_contact.solvers.stepping",
-    "run_scene": "fenics_contact.runner",
-}
-
-__all__ = sorted(_PUBLIC)
-
-
-def __getattr__(name: str) -> Any:
-    """Import a public name from its module on first access."""
-    try:
-        module = _PUBLIC[name]
-    except KeyError:
-        raise AttributeError(f"module 'fenics_contact' has no attribute {name!r}") from None
-    return getattr(importlib.import_module(module), name)
-
-
-def __dir__() -> list[str]:
-    return sorted([*globals(), *_PUBLIC])
+__all__ = [
+    "STRATEGIES",
+    "ContactProblem",
+    "ContactSettings",
+    "LinearSolverSettings",
+    "PrescribedDisplacement",
+    "RigidBall",
+    "RigidPlane",
+    "RunRecord",
+    "Scene",
+    "SceneError",
+    "SolverSettings",
+    "Status",
+    "StepRecord",
+    "SurfaceTraction",
+    "build_problem",
+    "load_scene",
+    "make_strategy",
+    "material",
+    "run_scene",
+    "solve_load_path",
+]

@@ -3,15 +3,15 @@
 from __future__ import annotations
 
 import argparse
-import importlib
 import sys
 import warnings
 from collections.abc import Sequence
 
 import fenics_contact  # noqa: F401  (imports the DOLFINx wheel first)
+from fenics_contact.cli import mesh, run, stability, study, tradeoff
 
 #: Subcommand modules, in the order ``--help`` lists them.
-SUBCOMMANDS = ("run", "study", "mesh", "tradeoff", "stability")
+SUBCOMMANDS = (run, study, mesh, tradeoff, stability)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -22,8 +22,8 @@ def build_parser() -> argparse.ArgumentParser:
         "Alart-Curnier augmented Lagrangian (FEniCSx).",
     )
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for name in SUBCOMMANDS:
-        importlib.import_module(f"fenics_contact.cli.{name}").register(sub)
+    for module in SUBCOMMANDS:
+        module.register(sub)
     return parser
 
 
