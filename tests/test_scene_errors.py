@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 
 from fenics_contact.cli import main
-from fenics_contact.scene.schema import SceneError, _Reader, load_scene
+from fenics_contact.scene.reader import _Reader
+from fenics_contact.scene.schema import SceneError, load_scene
 
 MESHES = Path(__file__).parent.parent / "meshes"
 

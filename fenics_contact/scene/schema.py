@@ -52,332 +52,47 @@ bottom = 3, top = 4; box xmin = 1, xmax = 2, ymin = 3, ymax = 4, zmin = 5,
 zmax = 6. Tags may be given by number or by name.
 """
 
-from __future__ import annotations
 
-import difflib
 import itertools
 import math
 import tomllib
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fenics_contact.model.contact import ContactSettings, r_problem
+from fenics_contact.model.contact import r_problem
 from fenics_contact.model.materials import MATERIALS, elastic_constants_problem
-from fenics_contact.solvers import STRATEGIES
-from fenics_contact.solvers.diagnostics import SolverSettings
+from fenics_contact.scene.reader import _array, _check_finite, _check_keys, _Reader, _table
+from fenics_contact.scene.spec import (
+    FIELDS,
+    FRICTION_FIELDS,
+    GENERATOR_TAGS,
+    METHODS,
+    BodySpec,
+    BoundarySpec,
+    ContactSpec,
+    MeshSpec,
+    ObstacleSpec,
+    PairSpec,
+    Scene,
+    SceneError,
+    SolverSpec,
+)
 
-#: Method names a scene may give: the strategy registry's.
-METHODS = tuple(STRATEGIES)
-#: Fields the XDMF output can hold.
-FIELDS = ("displacement", "contact_pressure", "gap", "active", "von_mises")
-#: Further fields of a frictional scene (tangential traction, slip increment,
-#: 0 open / 1 stick / 2 slip per node).
-FRICTION_FIELDS = ("tangential_traction", "slip", "stick_slip")
-GENERATOR_TAGS: dict[str, dict[str, int]] = {
-    "rectangle": {"left": 1, "right": 2, "bottom": 3, "top": 4},
-    "box": {"xmin": 1, "xmax": 2, "ymin": 3, "ymax": 4, "zmin": 5, "zmax": 6},
-}
-
-_SCHEMA: dict[str, set[str]] = {
-    "": {"scene", "mesh", "material", "dirichlet", "traction", "obstacle", "contact", "solver",
-         "output", "body", "pair"},
-    "body": {"name", "tag", "law", "E", "nu"},
-    "pair": {"name", "striker", "target", "r", "relative", "mu", "tangential_r_max"},
-    "scene": {"name", "dimension", "description"},
-    "mesh": {"file", "generator", "origin", "size", "cells", "cell", "parameters"},
-    "material": {"law", "E", "nu", "kinematics"},
-    "dirichlet": {"tag", "value", "x", "y", "z", "path"},
-    "traction": {"tag", "value"},
-    "obstacle": {"type", "point", "normal", "centre", "radius", "inside", "motion", "schedule"},
-    "contact": {"tag", "detect", "margin", "r", "relative", "quadrature", "mu",
-                "tangential_r_max"},
-    "solver": {"method", "steps", "max_iterations", "atol", "rtol", "max_cutbacks", "predictor",
-               "linear_solver"},
-    "output": {"fields", "pictures"},
-}
+#: Largest load-step count and Newton-iteration limit a scene may ask for: far
+#: beyond any useful run (a million linear solves), well short of running forever.
+MAX_STEPS = 100_000
+MAX_ITERATIONS = 100_000
+#: Largest number of halvings of a load increment (2^-60 of a step is below round-off).
+MAX_CUTBACKS = 60
 
 
-class SceneError(ValueError):
-    """A scene file mistake: the message names the key, the value and the fix."""
-
-
-@dataclass(frozen=True)
-class MeshSpec:
-    """Where the body mesh comes from."""
-
-    file: Path | None = None
-    generator: str | None = None
-    origin: tuple[float, ...] = ()
-    size: tuple[float, ...] = ()
-    cells: tuple[int, ...] = ()
-    cell: str = "quadrilateral"
-    parameters: dict[str, float] = field(default_factory=dict)
-
-
-@dataclass(frozen=True)
-class BoundarySpec:
-    """A Dirichlet or traction condition on tagged facets (value at load factor 1).
-
-    ``path``: optional knots (t, value...) of a piecewise-linear load path
-    (Dirichlet only), from t = 0 to t = 1.
-    """
-
-    tag: int | str
-    value: tuple[float | None, ...]
-    bounds: dict[int, tuple[float, float]] = field(default_factory=dict)
-    path: tuple[tuple[float, ...], ...] = ()
-
-
-@dataclass(frozen=True)
-class BodySpec:
-    """One body of a two-body scene: its cell tag (number or physical name) and law."""
-
-    name: str
-    tag: int | str
-    law: str
-    E: float
-    nu: float
-
-
-@dataclass(frozen=True)
-class PairSpec:
-    """A contact pair: striker facet tag against a target facet tag of a deformable body."""
-
-    name: str
-    striker: int | str
-    target: int | str
-    r: float = 1.0
-    relative: bool = True
-    mu: float | None = None
-    tangential_r_max: float | None = 2.0
-
-
-@dataclass(frozen=True)
-class ObstacleSpec:
-    """A rigid plane or ball and its motion."""
-
-    type: str
-    point: tuple[float, ...] = ()
-    normal: tuple[float, ...] = ()
-    radius: float = 0.0
-    inside: bool = False
-    motion: tuple[float, ...] = ()
-    schedule: tuple[tuple[float, ...], ...] = ()
-
-
-@dataclass(frozen=True)
-class ContactSpec(ContactSettings):
-    """Where contact may happen, and how it is regularised (r, relative, quadrature).
-
-    The settings the contact term takes (:class:`ContactSettings`) plus the
-    candidate facets (a tag, or detection along the obstacle's path within
-    ``margin``) and Coulomb friction (``mu``, None frictionless; the cap of
-    r_t, ``tangential_r_max`` E/L).
-    """
-
-    tag: int | str | None = None
-    detect: bool = False
-    margin: float = 0.0
-    mu: float | None = None
-    tangential_r_max: float | None = 2.0
-
-
-@dataclass(frozen=True)
-class SolverSpec(SolverSettings):
-    """Stopping rules (:class:`SolverSettings`) plus strategy and load stepping."""
-
-    rtol: float = 1e-10
-    method: str = "gnrm"
-    steps: int = 10
-    max_cutbacks: int = 4
-    predictor: str = "extrapolate"
-    linear_solver: str = "direct"
-
-
-@dataclass(frozen=True)
-class Scene:
-    """A validated scene."""
-
-    path: Path
-    name: str
-    dimension: int
-    mesh: MeshSpec
-    law: str
-    E: float
-    nu: float
-    dirichlet: tuple[BoundarySpec, ...]
-    tractions: tuple[BoundarySpec, ...]
-    obstacle: ObstacleSpec
-    contact: ContactSpec
-    solver: SolverSpec
-    fields: tuple[str, ...] = FIELDS
-    pictures: bool = True
-    description: str = ""
-    bodies: tuple[BodySpec, ...] = ()
-    pairs: tuple[PairSpec, ...] = ()
-
-    @property
-    def two_body(self) -> bool:
-        """True when the scene declares deformable bodies and contact pairs."""
-        return bool(self.pairs)
-
-
-class _Reader:
-    """Typed access to one TOML table with errors that name the key."""
-
-    def __init__(self, path: Path, section: str, table: dict[str, Any]) -> None:
-        self.path = path
-        self.section = section
-        self.table = table
-
-    def where(self, key: str) -> str:
-        return f"{self.path.name}: [{self.section}] {key}"
-
-    def fail(self, key: str, message: str) -> SceneError:
-        return SceneError(f"{self.where(key)} = {self.table.get(key)!r}: {message}")
-
-    def number(
-        self, key: str, default: float | None = None, *, positive: bool = False,
-        below: float | None = None,
-    ) -> float:
-        if key not in self.table:
-            if default is None:
-                raise SceneError(f"{self.where(key)} is missing: give a number.")
-            return default
-        value = self.table[key]
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            raise self.fail(key, "must be a number.")
-        if not math.isfinite(value):
-            raise self.fail(key, "must be finite.")
-        if positive and not value > 0:
-            raise self.fail(key, "must be > 0.")
-        if below is not None and not value < below:
-            raise self.fail(key, f"must be < {below}.")
-        return float(value)
-
-    def integer(
-        self, key: str, default: int, *, minimum: int = 0, maximum: int | None = None
-    ) -> int:
-        value = self.table.get(key, default)
-        if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
-            raise self.fail(key, f"must be an integer >= {minimum}.")
-        if maximum is not None and value > maximum:
-            raise self.fail(key, f"must be at most {maximum}; {why_bounded(key)}")
-        return int(value)
-
-    def flag(self, key: str, default: bool) -> bool:
-        value = self.table.get(key, default)
-        if not isinstance(value, bool):
-            raise self.fail(key, "must be true or false.")
-        return value
-
-    def choice(self, key: str, options: tuple[str, ...], default: str | None = None) -> str:
-        if key not in self.table and default is not None:
-            return default
-        value = self.table.get(key)
-        if not isinstance(value, str) or value.lower() not in options:
-            raise SceneError(
-                f"{self.where(key)} = {value!r}: choose one of {', '.join(options)}."
-            )
-        return value.lower()
-
-    def vector(
-        self, key: str, dimension: int, *, allow_free: bool = False, default: tuple = (),
-    ) -> tuple:
-        if key not in self.table:
-            if default:
-                return default
-            raise SceneError(f"{self.where(key)} is missing: give {dimension} numbers.")
-        value = self.table[key]
-        if not isinstance(value, list) or len(value) != dimension:
-            raise self.fail(
-                key, f"must be a list of {dimension} numbers (the scene is {dimension}D)."
-            )
-        out: list[float | None] = []
-        for v in value:
-            if allow_free and v == "free":
-                out.append(None)
-            elif isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v):
-                out.append(float(v))
-            else:
-                hint = ' or "free"' if allow_free else ""
-                raise self.fail(key, f"entries must be finite numbers{hint}.")
-        return tuple(out)
-
-    def tag(self, key: str) -> int | str:
-        value = self.table.get(key)
-        if isinstance(value, bool) or not isinstance(value, int | str):
-            raise SceneError(
-                f"{self.where(key)} = {value!r}: give a facet tag number or a physical name."
-            )
-        return value
-
-
-def _check_keys(path: Path, section: str, table: dict[str, Any]) -> None:
-    allowed = _SCHEMA[section]
-    for key in table:
-        if key not in allowed:
-            close = difflib.get_close_matches(key, sorted(allowed), n=1)
-            hint = f" Did you mean {close[0]!r}?" if close else ""
-            where = f"[{section}]" if section else "top level"
-            raise SceneError(
-                f"{path.name}: unknown key {key!r} at {where}.{hint} "
-                f"Allowed: {', '.join(sorted(allowed))}."
-            )
-
-
-def _non_finite(value: object) -> list[str | int] | None:
-    """The keys and indices leading to the first NaN or infinite number in ``value``, or None."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return []
-    items = (
-        value.items() if isinstance(value, dict)
-        else enumerate(value) if isinstance(value, list) else ()
-    )
-    for key, item in items:
-        found = _non_finite(item)
-        if found is not None:
-            return [key, *found]
-    return None
-
-
-def _check_finite(path: Path, data: dict[str, Any]) -> None:
-    """Refuse a NaN or infinite number anywhere in the scene, naming where it is."""
-    for section, table in data.items():
-        tables = table if isinstance(table, list) else [table]
-        for i, entry in enumerate(tables):
-            found = _non_finite(entry)
-            if not found:
-                continue
-            name = f"[{section} {i + 1}]" if isinstance(table, list) else f"[{section}]"
-            key, *inner = found
-            at = "".join(f"[{k}]" if isinstance(k, int) else f".{k}" for k in inner)
-            raise SceneError(
-                f"{path.name}: {name} {key} = {entry[key]!r}: holds a NaN or infinite number"
-                f"{' at ' + at if at else ''}; give finite numbers."
-            )
-
-
-def _table(path: Path, data: dict[str, Any], section: str, required: bool = True) -> _Reader:
-    if section not in data:
-        if required:
-            raise SceneError(f"{path.name}: the [{section}] table is missing; add it.")
-        return _Reader(path, section, {})
-    table = data[section]
-    if not isinstance(table, dict):
-        raise SceneError(f"{path.name}: [{section}] must be a table, not {type(table).__name__}.")
-    _check_keys(path, section, table)
-    return _Reader(path, section, table)
-
-
-def _array(path: Path, data: dict[str, Any], section: str) -> list[_Reader]:
-    items = data.get(section, [])
-    if not isinstance(items, list) or not all(isinstance(t, dict) for t in items):
-        raise SceneError(f"{path.name}: use [[{section}]] blocks for {section} conditions.")
-    for t in items:
-        _check_keys(path, section, t)
-    return [_Reader(path, f"[{section}]", t) for t in items]
+def why_bounded(key: str) -> str:
+    """The fix that goes with a bounded integer key."""
+    if key == "steps":
+        return "a finer load path rarely helps past a few hundred steps; use fewer."
+    if key == "max_cutbacks":
+        return "each halves the increment; 60 halvings reach round-off."
+    return "a Newton solve that needs more has failed; lower it."
 
 
 def _mesh(path: Path, reader: _Reader, dimension: int) -> MeshSpec:
@@ -625,31 +340,18 @@ def _friction(reader: _Reader) -> float | None:
     return mu
 
 
-#: Largest load-step count and Newton-iteration limit a scene may ask for: far
-#: beyond any useful run (a million linear solves), well short of running forever.
-MAX_STEPS = 100_000
-MAX_ITERATIONS = 100_000
-#: Largest number of halvings of a load increment (2^-60 of a step is below round-off).
-MAX_CUTBACKS = 60
-
-
-def why_bounded(key: str) -> str:
-    """The fix that goes with a bounded integer key."""
-    if key == "steps":
-        return "a finer load path rarely helps past a few hundred steps; use fewer."
-    if key == "max_cutbacks":
-        return "each halves the increment; 60 halvings reach round-off."
-    return "a Newton solve that needs more has failed; lower it."
-
-
 def _solver(reader: _Reader) -> SolverSpec:
+    def bounded(key: str, default: int, minimum: int, maximum: int) -> int:
+        return reader.integer(key, default, minimum=minimum, maximum=maximum,
+                              why=why_bounded(key))
+
     return SolverSpec(
         method=reader.choice("method", METHODS, default="gnrm"),
-        steps=reader.integer("steps", 10, minimum=1, maximum=MAX_STEPS),
-        max_iterations=reader.integer("max_iterations", 50, minimum=1, maximum=MAX_ITERATIONS),
+        steps=bounded("steps", 10, 1, MAX_STEPS),
+        max_iterations=bounded("max_iterations", 50, 1, MAX_ITERATIONS),
         atol=reader.number("atol", 1e-8, positive=True),
         rtol=reader.number("rtol", 1e-10) if "rtol" in reader.table else 1e-10,
-        max_cutbacks=reader.integer("max_cutbacks", 4, minimum=0, maximum=MAX_CUTBACKS),
+        max_cutbacks=bounded("max_cutbacks", 4, 0, MAX_CUTBACKS),
         predictor=reader.choice("predictor", ("extrapolate", "previous"), default="extrapolate"),
         linear_solver=reader.choice("linear_solver", ("direct", "iterative"), default="direct"),
     )
@@ -779,3 +481,24 @@ def _two_body_scene(path: Path, data: dict[str, Any], head: _Reader, dimension: 
         bodies=bodies,
         pairs=pairs,
     )
+
+
+__all__ = [
+    "FIELDS",
+    "FRICTION_FIELDS",
+    "GENERATOR_TAGS",
+    "MAX_CUTBACKS",
+    "MAX_ITERATIONS",
+    "MAX_STEPS",
+    "METHODS",
+    "BodySpec",
+    "BoundarySpec",
+    "ContactSpec",
+    "MeshSpec",
+    "ObstacleSpec",
+    "PairSpec",
+    "Scene",
+    "SceneError",
+    "SolverSpec",
+    "load_scene",
+]

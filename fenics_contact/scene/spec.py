@@ -1,0 +1,152 @@
+"""What a scene declares: the validated description of a problem (dataclasses, no I/O).
+
+:func:`fenics_contact.scene.schema.load_scene` fills these from a TOML
+file; :func:`fenics_contact.scene.build.build_problem` builds the model from
+them. Units are the user's (be consistent); sign conventions are those of
+:mod:`fenics_contact.model.contact`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.solvers import STRATEGIES
+from fenics_contact.solvers.diagnostics import SolverSettings
+
+#: Method names a scene may give: the strategy registry's.
+METHODS = tuple(STRATEGIES)
+#: Fields the XDMF output can hold.
+FIELDS = ("displacement", "contact_pressure", "gap", "active", "von_mises")
+#: Further fields of a frictional scene (tangential traction, slip increment,
+#: 0 open / 1 stick / 2 slip per node).
+FRICTION_FIELDS = ("tangential_traction", "slip", "stick_slip")
+GENERATOR_TAGS: dict[str, dict[str, int]] = {
+    "rectangle": {"left": 1, "right": 2, "bottom": 3, "top": 4},
+    "box": {"xmin": 1, "xmax": 2, "ymin": 3, "ymax": 4, "zmin": 5, "zmax": 6},
+}
+
+class SceneError(ValueError):
+    """A scene file mistake: the message names the key, the value and the fix."""
+
+
+@dataclass(frozen=True)
+class MeshSpec:
+    """Where the body mesh comes from."""
+
+    file: Path | None = None
+    generator: str | None = None
+    origin: tuple[float, ...] = ()
+    size: tuple[float, ...] = ()
+    cells: tuple[int, ...] = ()
+    cell: str = "quadrilateral"
+    parameters: dict[str, float] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class BoundarySpec:
+    """A Dirichlet or traction condition on tagged facets (value at load factor 1).
+
+    ``path``: optional knots (t, value...) of a piecewise-linear load path
+    (Dirichlet only), from t = 0 to t = 1.
+    """
+
+    tag: int | str
+    value: tuple[float | None, ...]
+    bounds: dict[int, tuple[float, float]] = field(default_factory=dict)
+    path: tuple[tuple[float, ...], ...] = ()
+
+
+@dataclass(frozen=True)
+class BodySpec:
+    """One body of a two-body scene: its cell tag (number or physical name) and law."""
+
+    name: str
+    tag: int | str
+    law: str
+    E: float
+    nu: float
+
+
+@dataclass(frozen=True)
+class PairSpec:
+    """A contact pair: striker facet tag against a target facet tag of a deformable body."""
+
+    name: str
+    striker: int | str
+    target: int | str
+    r: float = 1.0
+    relative: bool = True
+    mu: float | None = None
+    tangential_r_max: float | None = 2.0
+
+
+@dataclass(frozen=True)
+class ObstacleSpec:
+    """A rigid plane or ball and its motion."""
+
+    type: str
+    point: tuple[float, ...] = ()
+    normal: tuple[float, ...] = ()
+    radius: float = 0.0
+    inside: bool = False
+    motion: tuple[float, ...] = ()
+    schedule: tuple[tuple[float, ...], ...] = ()
+
+
+@dataclass(frozen=True)
+class ContactSpec(ContactSettings):
+    """Where contact may happen, and how it is regularised (r, relative, quadrature).
+
+    The settings the contact term takes (:class:`ContactSettings`) plus the
+    candidate facets (a tag, or detection along the obstacle's path within
+    ``margin``) and Coulomb friction (``mu``, None frictionless; the cap of
+    r_t, ``tangential_r_max`` E/L).
+    """
+
+    tag: int | str | None = None
+    detect: bool = False
+    margin: float = 0.0
+    mu: float | None = None
+    tangential_r_max: float | None = 2.0
+
+
+@dataclass(frozen=True)
+class SolverSpec(SolverSettings):
+    """Stopping rules (:class:`SolverSettings`) plus strategy and load stepping."""
+
+    rtol: float = 1e-10
+    method: str = "gnrm"
+    steps: int = 10
+    max_cutbacks: int = 4
+    predictor: str = "extrapolate"
+    linear_solver: str = "direct"
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene."""
+
+    path: Path
+    name: str
+    dimension: int
+    mesh: MeshSpec
+    law: str
+    E: float
+    nu: float
+    dirichlet: tuple[BoundarySpec, ...]
+    tractions: tuple[BoundarySpec, ...]
+    obstacle: ObstacleSpec
+    contact: ContactSpec
+    solver: SolverSpec
+    fields: tuple[str, ...] = FIELDS
+    pictures: bool = True
+    description: str = ""
+    bodies: tuple[BodySpec, ...] = ()
+    pairs: tuple[PairSpec, ...] = ()
+
+    @property
+    def two_body(self) -> bool:
+        """True when the scene declares deformable bodies and contact pairs."""
+        return bool(self.pairs)
