@@ -319,7 +319,7 @@ class FrictionMixin:
         tangents; a frame not aligned with the plane is refused. Returns the
         number of constrained (node, component) pairs (global).
         """
-        conditions = [c for _, c, _ in getattr(self, "_bc_constants", [])]
+        conditions = [c for _, c, _ in self._bc_constants]  # type: ignore[attr-defined]
         planes = symmetry_planes(self.domain, conditions)
         if not planes:
             return 0
