@@ -67,3 +67,17 @@ def test_the_check_finds_an_upward_import(tmp_path, layer, source, caught):
     (package / layer).mkdir(parents=True)
     (package / layer / "bad.py").write_text(source)
     assert bool(violations(package)) == caught
+
+
+def test_no_module_outside_the_model_probes_the_problem_kind():
+    """Solvers, output and studies read ``problem.frictional`` and the problem's methods
+    (``laws``, ``body_ids``); they never ask what kind of problem they hold."""
+    import re
+
+    probe = re.compile(r"\b(hasattr|getattr|isinstance)\((self\.)?(problem|state)\b")
+    found = [
+        f"{path.relative_to(PACKAGE)}:{number}"
+        for path in sorted(PACKAGE.rglob("*.py")) if "model" not in path.parts
+        for number, line in enumerate(path.read_text().splitlines(), 1) if probe.search(line)
+    ]
+    assert found == []

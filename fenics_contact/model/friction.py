@@ -186,10 +186,7 @@ class FrictionalContactState(ContactState):
     slip: np.ndarray = field(default_factory=lambda: np.zeros((0, 1)))
     coulomb_limit: np.ndarray = field(default_factory=lambda: np.zeros(0))
     node_state: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int8))
-    tangential_force: float = 0.0
     tangential_magnitude: float = 0.0
-    stick_count: int = 0
-    slip_count: int = 0
 
 
 def check_friction(mu: float, tangential_r_max: float | None) -> None:
@@ -220,6 +217,7 @@ class FrictionMixin:
     the frictional systems and the nodal diagnostics.
     """
 
+    frictional = True
     domain: object
     comm: MPI.Comm
     surface: ContactSurface
@@ -528,19 +526,20 @@ class FrictionMixin:
         base = super().contact_state()  # type: ignore[misc]
         states = self.node_states()
         comm = self.comm
-        return FrictionalContactState(
-            **{f: getattr(base, f) for f in base.__dataclass_fields__},
-            tangential_traction=self._nodal_components(self._tau_forms),
-            slip=self._nodal_components(self._slip_forms),
-            coulomb_limit=self.surface.nodal(self._rho_form),
-            node_state=states,
-            tangential_force=float(np.linalg.norm(self.tangential_force_vector())),
-            tangential_magnitude=comm.allreduce(
+        normal = {f: getattr(base, f) for f in base.__dataclass_fields__}
+        return FrictionalContactState(**{
+            **normal,
+            "tangential_traction": self._nodal_components(self._tau_forms),
+            "slip": self._nodal_components(self._slip_forms),
+            "coulomb_limit": self.surface.nodal(self._rho_form),
+            "node_state": states,
+            "tangential_force": float(np.linalg.norm(self.tangential_force_vector())),
+            "tangential_magnitude": comm.allreduce(
                 fem.assemble_scalar(self._tmag_form), op=MPI.SUM
             ),
-            stick_count=comm.allreduce(int(np.sum(states == STICK)), op=MPI.SUM),
-            slip_count=comm.allreduce(int(np.sum(states == SLIP)), op=MPI.SUM),
-        )
+            "stick_count": comm.allreduce(int(np.sum(states == STICK)), op=MPI.SUM),
+            "slip_count": comm.allreduce(int(np.sum(states == SLIP)), op=MPI.SUM),
+        })
 
     def coulomb_violations(self) -> tuple[float, float, float]:
         """Worst nodal violations of the Coulomb conditions, global over ranks.

@@ -491,6 +491,10 @@ class TwoBodyProblem(ContactProblem):
         vec.destroy()
         return out
 
+    def laws(self) -> list[tuple[Elastic, np.ndarray | None]]:
+        """Each body's law and the cells it holds."""
+        return [(b.material, self.cell_tags.find(b.tag)) for b in self.bodies]
+
     def body_ids(self) -> fem.Function:
         """Cell-wise body index (0, 1, ...) in the order of ``bodies`` (DG0)."""
         D = fem.functionspace(self.domain, ("DG", 0))

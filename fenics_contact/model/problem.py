@@ -195,6 +195,9 @@ class ContactState:
             the discretisation's own gap (to the plane of each node's assigned
             facet), while ``max_penetration`` is the depth inside the actual
             target surface; None where the two are one (rigid obstacles).
+        tangential_force: global |int T tau dA| (force); 0 without friction.
+        stick_count: global number of sticking contact nodes (0 without friction).
+        slip_count: global number of slipping contact nodes (0 without friction).
     """
 
     gap: np.ndarray
@@ -205,6 +208,9 @@ class ContactState:
     max_penetration: float
     contact_force: float
     constraint_penetration: float | None = None
+    tangential_force: float = 0.0
+    stick_count: int = 0
+    slip_count: int = 0
 
     @classmethod
     def gathered(
@@ -266,7 +272,11 @@ class ProblemBase:
     lam: fem.Function
     r: fem.Constant
     load_factor: float
+    bcs: list[fem.DirichletBC]
     _bc_constants: list[tuple[fem.Constant, PrescribedDisplacement, int]]
+    #: Whether the contact carries Coulomb friction (a tangential multiplier lam_t,
+    #: the Coulomb checks, r_t); solvers read this instead of probing the problem.
+    frictional = False
 
     @property
     def stiffness_scale(self) -> float:
@@ -640,6 +650,14 @@ class ContactProblem(ProblemBase):
         pressure = self.surface.nodal(self._pressure_form)
         self.lam.x.array[: pressure.size] = pressure
         self.lam.x.scatter_forward()
+
+    def laws(self) -> list[tuple[Elastic, np.ndarray | None]]:
+        """Each body's law and its cells (None: every cell): one body here."""
+        return [(self.material, None)]
+
+    def body_ids(self) -> fem.Function | None:
+        """Cell-wise body index for the output; None for a single body."""
+        return None
 
     def nodal_coordinates(self) -> np.ndarray:
         """Reference coordinates of the owned multiplier nodes, shape (n, 3)."""

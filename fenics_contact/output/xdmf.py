@@ -144,7 +144,7 @@ class StepWriter:
     ) -> None:
         if problem.V.ufl_element().embedded_superdegree != 1:
             raise ValueError("XDMF output needs P1 displacement; interpolate higher orders first.")
-        known = FIELDS + FRICTION_FIELDS if hasattr(problem, "lam_t") else FIELDS
+        known = FIELDS + FRICTION_FIELDS if problem.frictional else FIELDS
         unknown = set(fields) - set(known)
         if unknown:
             raise ValueError(f"Unknown output fields {sorted(unknown)}; choose from {known}.")
@@ -168,19 +168,14 @@ class StepWriter:
         self._q = fem.Function(problem.Q)
         self._stress = None
         S = fem.functionspace(problem.domain, ("DG", 0))
-        # Two-body problems: each body's law on its own cells, and a body-id field.
-        bodies = getattr(problem, "bodies", None)
-        self._body_id = problem.body_ids() if bodies else None
+        # Each body's law on its own cells; several bodies add a body-id field.
+        self._body_id = problem.body_ids()
         if "von_mises" in self.fields:
             self._stress = fem.Function(S, name="von_mises")
-            laws = (
-                [(b.material, problem.cell_tags.find(b.tag)) for b in bodies] if bodies
-                else [(problem.material, None)]
-            )
             self._stress_exprs = [
                 (fem.Expression(von_mises(law.cauchy_stress(problem.u)),
                                 S.element.interpolation_points), cells)
-                for law, cells in laws
+                for law, cells in problem.laws()
             ]
 
     def _prepare(self, first_step: int) -> None:

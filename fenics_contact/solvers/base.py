@@ -111,9 +111,9 @@ def retry_lowering_r_t(
     attempt fails the cap of r_t is put back (the converged nodal answer does
     not depend on r_t, so a lowered cap is kept only when it helped).
     """
-    lower = getattr(problem, "lower_tangential_r", None)
-    if lower is None or status not in TANGENTIAL_RETRY:
+    if not problem.frictional or status not in TANGENTIAL_RETRY:
         return status
+    lower = problem.lower_tangential_r  # type: ignore[attr-defined]
     cap = problem.tangential_cap
     for _ in range(halvings):
         problem.restore(saved, load=False)

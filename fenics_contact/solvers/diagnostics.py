@@ -256,7 +256,7 @@ def signorini_admissibility(
     """
     from mpi4py import MPI
 
-    if getattr(problem.surface, "quadrature", "nodal") != "nodal":
+    if problem.surface.quadrature != "nodal":
         return None
 
     h = float(problem.surface.h)
@@ -297,9 +297,7 @@ def coulomb_admissibility(
     Coulomb disc at most ``settings.tension_tol * E``; else a sentence naming
     the violation. None (no test) without friction or with the Gauss rule.
     """
-    if not hasattr(problem, "coulomb_violations"):
-        return None
-    if getattr(problem.surface, "quadrature", "nodal") != "nodal":
+    if not problem.frictional or problem.surface.quadrature != "nodal":
         return None
     h = float(problem.surface.h)
     E = float(problem.material.E)
@@ -321,7 +319,7 @@ def prescribed_admissibility(
 
     None when the problem prescribes no displacement.
     """
-    if not getattr(problem, "bcs", None):
+    if not problem.bcs:
         return None
     h = float(problem.surface.h)
 

@@ -30,7 +30,7 @@ class GeneralizedNewton(NewtonStrategy):
         return problem.augmented_system()
 
     def _solve(self) -> SolveResult:
-        if not hasattr(self.problem, "lower_tangential_r"):  # frictionless: plain Newton
+        if not self.problem.frictional:  # frictionless: plain Newton
             return super()._solve()
         saved = self.problem.snapshot()
         results = [super()._solve()]

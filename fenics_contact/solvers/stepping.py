@@ -306,8 +306,8 @@ def solve_load_path(
         step.active_count = state.active_count
         step.max_penetration = state.max_penetration
         step.contact_force = state.contact_force
-        for name in ("tangential_force", "stick_count", "slip_count"):  # frictional states
-            setattr(step, name, getattr(state, name, getattr(step, name)))
+        step.tangential_force = state.tangential_force
+        step.stick_count, step.slip_count = state.stick_count, state.slip_count
         run.steps.append(step)
         run.wall_s += time.perf_counter() - run_start
         run_start = time.perf_counter()

@@ -256,8 +256,7 @@ def run_case(
 
     try:
         problem = scene.build(ContactSettings(r=case.r, relative=True), comm)
-        mu = getattr(problem, "mu", None)
-        record.mu = None if mu is None else float(mu.value)
+        record.mu = problem.friction_coefficient if problem.frictional else None
         atol = scaled_atol(problem, force_rtol)
         strategy = make_strategy(
             method, problem, SolverSettings(atol=atol, max_iterations=max_iterations)

@@ -200,9 +200,10 @@ def contact_profile(problem: ContactProblem) -> ContactProfile:
     comm = problem.comm
     x = problem.nodal_coordinates()[:, 0]
     n = x.size
-    tau = getattr(state, "tangential_traction", np.zeros((n, 1)))[:, 0]
-    limit = getattr(state, "coulomb_limit", np.zeros(n))
-    node = getattr(state, "node_state", np.where(state.pressure < 0, STICK, OPEN))
+    if problem.frictional:
+        tau, limit, node = state.tangential_traction[:, 0], state.coulomb_limit, state.node_state
+    else:
+        tau, limit, node = np.zeros(n), np.zeros(n), np.where(state.pressure < 0, STICK, OPEN)
 
     def gathered(values: np.ndarray) -> np.ndarray:
         return np.concatenate(comm.allgather(np.asarray(values)))

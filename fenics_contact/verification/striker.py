@@ -71,6 +71,9 @@ def node_to_segment_gap(
 class TargetSurface:
     """The target facet's submesh, its multiplier space and the point measure."""
 
+    #: The point measure sits at the striker node: the nodal rule.
+    quadrature = "nodal"
+
     submesh: mesh.Mesh
     Q: fem.FunctionSpace
     ds: ufl.Measure
