@@ -82,6 +82,23 @@ def _copy(finished, tmp_path):
     return scene, copy
 
 
+def _damage(path: Path, how: str, keep: int = 100, flip: int = 8) -> int:
+    """Truncate ``path`` to ``keep`` bytes, flip ``flip`` bytes in its middle, or remove it.
+
+    Returns its size before.
+    """
+    data = path.read_bytes()
+    if how == "truncated":
+        path.write_bytes(data[:keep])
+    elif how == "missing":
+        path.unlink()
+    else:
+        middle = len(data) // 2
+        path.write_bytes(data[:middle] + bytes(b ^ 0xFF for b in data[middle:middle + flip])
+                         + data[middle + flip:])
+    return len(data)
+
+
 def _resume(scene, out, capsys):
     code = main(["run", str(scene), "--resume", str(out), "--quiet"])
     err = capsys.readouterr().err.strip()
@@ -93,13 +110,7 @@ def _resume(scene, out, capsys):
 def test_a_damaged_checkpoint_file_is_named(finished, tmp_path, capsys, damage):
     scene, out = _copy(finished, tmp_path)
     npz = next((out / "checkpoint").glob("step_*/rank_0000.npz"))
-    data = npz.read_bytes()
-    if damage == "truncated":
-        npz.write_bytes(data[: len(data) // 2])
-    else:
-        middle = len(data) // 2
-        npz.write_bytes(data[:middle] + bytes(b ^ 0xFF for b in data[middle:middle + 64])
-                        + data[middle + 64:])
+    _damage(npz, damage, keep=npz.stat().st_size // 2, flip=64)
     code, err = _resume(scene, out, capsys)
     assert code == 2
     assert f"{npz} is damaged or unreadable" in err
@@ -109,18 +120,10 @@ def test_a_damaged_checkpoint_file_is_named(finished, tmp_path, capsys, damage):
 def test_a_damaged_step_file_is_named(finished, tmp_path, capsys, damage):
     scene, out = _copy(finished, tmp_path)
     h5 = out / "solution" / "step_0001.h5"
-    data = h5.read_bytes()
-    if damage == "truncated":
-        h5.write_bytes(data[:100])
-    elif damage == "missing":
-        h5.unlink()
-    else:
-        middle = len(data) // 2
-        h5.write_bytes(data[:middle] + bytes(b ^ 0xFF for b in data[middle:middle + 8])
-                       + data[middle + 8:])
+    size = _damage(h5, damage)
     code, err = _resume(scene, out, capsys)
     assert code == 2
-    why = {"truncated": f"has 100 bytes instead of {len(data)}", "missing": "is missing",
+    why = {"truncated": f"has 100 bytes instead of {size}", "missing": "is missing",
            "edited": "changed since the step was written"}[damage]
     assert f"Output file {h5} {why}" in err
 
