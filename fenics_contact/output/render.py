@@ -1,0 +1,131 @@
+"""Draw any field of any finished load step of a run, from its files alone (PyVista, off-screen).
+
+Reads ``OUT/solution/step_NNNN.xdmf`` and its HDF5 file (each step's own
+files, complete once the index names them), warps the mesh by the
+displacement (true scale) and colours it by the chosen field: a point or cell
+field, vectors by their magnitude. Nothing of the run is rebuilt: no mesh
+object, no forms. The HDF5 data is read with h5py: VTK's own XDMF reader
+brings a second HDF5 library that must not meet DOLFINx's in one process.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from xml.etree import ElementTree
+
+import numpy as np
+
+from fenics_contact.output.xdmf import finished_steps, step_folder
+
+#: VTK cell type of each XDMF topology DOLFINx writes (the same vertex order).
+_VTK_CELLS = {"Triangle": 5, "Quadrilateral": 9, "Tetrahedron": 10, "Hexahedron": 12}
+#: Colour maps: pressure dark where high (as in deformed.png), the others sequential.
+_CMAPS = {"contact_pressure": "inferno_r", "active": "cividis", "stick_slip": "cividis"}
+
+
+def _step_file(out: Path, step: int | None) -> tuple[Path, int]:
+    """The step file of ``step`` (None: the last finished one), or ValueError naming the steps."""
+    index = out / "solution.xdmf"
+    steps = finished_steps(index) if index.is_file() else []
+    if not steps:
+        raise ValueError(
+            f"{out} holds no finished load step (no {index.name}); give the --out folder of a "
+            "run that finished at least one step."
+        )
+    chosen = steps[-1] if step is None else step
+    if chosen not in steps:
+        raise ValueError(
+            f"Step {chosen} is not among the finished steps of {out} "
+            f"({steps[0]}-{steps[-1]}); choose one of those."
+        )
+    return step_folder(index) / f"step_{chosen:04d}.xdmf", chosen
+
+
+def _read_step(source: Path):
+    """The step's mesh as a PyVista grid with every field of the step file attached."""
+    import h5py
+    import pyvista
+
+    root = ElementTree.parse(source).getroot()
+    mesh = next(g for g in root.iter("Grid") if g.get("GridType") == "Uniform")
+    kind = mesh.find("Topology").get("TopologyType")  # type: ignore[union-attr]
+    if kind not in _VTK_CELLS:
+        raise ValueError(f"{source}: cells of type {kind!r} cannot be drawn here.")
+    fields = {a.get("Name"): a for a in root.iter("Attribute")}
+    with h5py.File(source.with_suffix(".h5"), "r") as f:
+        x = f["Mesh/mesh/geometry"][()]
+        cells = f["Mesh/mesh/topology"][()].astype(np.int64)
+        points = np.pad(x, ((0, 0), (0, 3 - x.shape[1])))
+        layout = np.hstack([np.full((cells.shape[0], 1), cells.shape[1]), cells]).ravel()
+        grid = pyvista.UnstructuredGrid(
+            layout, np.full(cells.shape[0], _VTK_CELLS[kind], np.uint8), points
+        )
+        for name, attribute in fields.items():
+            item = attribute.find("DataItem")
+            dataset = item.text.strip().split(":", 1)[1]  # type: ignore[union-attr]
+            values = f[dataset][()]
+            values = values[:, 0] if values.ndim == 2 and values.shape[1] == 1 else values
+            target = grid.point_data if attribute.get("Center") == "Node" else grid.cell_data
+            target[name] = values
+    return grid
+
+
+def render_step(
+    out: Path, *, step: int | None = None, field: str = "contact_pressure",
+    path: Path | None = None, window: tuple[int, int] = (1200, 800),
+) -> Path:
+    """Render ``field`` of load step ``step`` of the run in ``out`` on the deformed mesh.
+
+    Args:
+        out: the run's output folder (``fenics-contact run ... --out OUT``).
+        step: the load step (1-based; None: the last finished one).
+        field: a point or cell field of the step file; vectors are drawn by magnitude.
+        path: the PNG to write (default ``OUT/render_step_NNNN_FIELD.png``).
+        window: image size in pixels.
+
+    Returns:
+        The PNG written. Raises ValueError naming the available steps or fields.
+    """
+    import pyvista
+
+    source, chosen = _step_file(out, step)
+    grid = _read_step(source)
+    names = sorted(set(grid.point_data) | set(grid.cell_data))
+    if field not in names:
+        raise ValueError(
+            f"Field {field!r} is not in step {chosen} of {out}; available: {', '.join(names)}."
+        )
+    if "displacement" in grid.point_data:
+        u = np.asarray(grid.point_data["displacement"], dtype=float)
+        grid.points = np.asarray(grid.points) + u[:, :3]
+    data = grid.point_data if field in grid.point_data else grid.cell_data
+    values = np.asarray(data[field], dtype=float)
+    label = field.replace("_", " ")
+    if values.ndim > 1:
+        values = np.linalg.norm(values, axis=1)
+        label = f"|{label}|"
+    if field == "contact_pressure":
+        values, label = -values, "contact pressure -lam"
+    data[label] = values
+    flat = float(np.ptp(np.asarray(grid.points)[:, 2])) == 0.0
+    pyvista.OFF_SCREEN = True
+    pyvista.vtk_verbosity("off")
+    plotter = pyvista.Plotter(off_screen=True, window_size=window)
+    plotter.add_mesh(
+        grid, scalars=label, cmap=_CMAPS.get(field, "viridis"), show_edges=flat,
+        edge_color="#777777", scalar_bar_args={"title": label},
+    )
+    if flat:
+        plotter.view_xy()
+        plotter.camera.parallel_projection = True
+    else:
+        plotter.view_vector((1.0, -1.3, -0.8), viewup=(0.0, 0.0, 1.0))
+    plotter.add_text(f"{out.name}: step {chosen}, {label}", font_size=12)
+    target = path or out / f"render_step_{chosen:04d}_{field}.png"
+    target.parent.mkdir(parents=True, exist_ok=True)
+    plotter.screenshot(str(target))
+    plotter.close()
+    return target
+
+
+__all__ = ["render_step"]
