@@ -12,7 +12,11 @@ from mpi4py import MPI
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import material
 from fenics_contact.model.obstacles import RigidPlane
-from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
+from fenics_contact.model.problem import (
+    ContactProblem,
+    PrescribedDisplacement,
+    one_body_problem,
+)
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.base import SolveResult
 from fenics_contact.solvers.diagnostics import (
@@ -30,7 +34,7 @@ def square_problem(cell=mesh.CellType.triangle) -> ContactProblem:
     fdim = 1
     bottom = mesh.locate_entities_boundary(domain, fdim, lambda x: np.isclose(x[1], 0.0))
     left = mesh.locate_entities_boundary(domain, fdim, lambda x: np.isclose(x[0], 0.0))
-    return ContactProblem(
+    return one_body_problem(
         domain, material("svk", 210.0, 0.3), RigidPlane(domain, (0.0, 0.0), (0.0, 1.0)),
         bottom, ContactSettings(r=1.0), prescribed=[PrescribedDisplacement(left, (0.0, 0.0))],
     )
@@ -200,7 +204,7 @@ def test_signorini_test_names_penetration_and_tension_in_their_units():
     assert check().startswith("tension 0.001 > tension_tol * E = 1e-06 * 210")
     problem.lam.x.array[:] = 1e-4  # below 2.1e-4
     assert check() is None
-    gauss = ContactProblem(
+    gauss = one_body_problem(
         problem.domain, problem.material, problem.obstacle, problem.surface.facets,
         ContactSettings(r=1.0, quadrature="gauss"),
     )

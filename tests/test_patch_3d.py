@@ -16,7 +16,10 @@ from mpi4py import MPI
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import LinearElastic, NeoHookean
 from fenics_contact.model.obstacles import RigidPlane
-from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
+from fenics_contact.model.problem import (
+    PrescribedDisplacement,
+    one_body_problem,
+)
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.stepping import solve_load_path
@@ -44,7 +47,7 @@ def block(dim, law, method="gnrm", quadrature="nodal"):
         prescribed.append(PrescribedDisplacement(side(1, 0.0), (None, 0.0, None)))
     normal = np.eye(dim)[top_axis]
     plane = RigidPlane(domain, np.zeros(dim), normal)
-    problem = ContactProblem(
+    problem = one_body_problem(
         domain, law, plane, side(top_axis, 0.0),
         ContactSettings(r=10.0, quadrature=quadrature), prescribed=prescribed,
     )

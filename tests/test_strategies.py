@@ -12,7 +12,7 @@ from fenics_contact.cli import main
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import SaintVenantKirchhoff
 from fenics_contact.model.obstacles import RigidPlane
-from fenics_contact.model.problem import ContactProblem, SurfaceTraction
+from fenics_contact.model.problem import SurfaceTraction, one_body_problem
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings, Status
 from fenics_contact.solvers.stepping import solve_load_path
@@ -79,7 +79,7 @@ def test_singular_system_is_reported_as_divergence_not_an_exception():
     bottom = mesh.locate_entities_boundary(domain, fdim, lambda x: np.isclose(x[1], 0.0))
     plane = RigidPlane(domain, [0.0, -1.0], [0.0, 1.0])
     top = mesh.locate_entities_boundary(domain, fdim, lambda x: np.isclose(x[1], 1.0))
-    problem = ContactProblem(
+    problem = one_body_problem(
         domain, SaintVenantKirchhoff(210.0, 0.3), plane, bottom, ContactSettings(),
         tractions=[SurfaceTraction(top, (1.0, 0.0))],
     )

@@ -76,7 +76,9 @@ def test_stability_two_body_friction_records_coulomb_ratio_and_reference(tmp_pat
     """Sliding blocks with friction: F_t / (mu N) and the reference (GNRM at r = 1 E/h).
 
     At r = 1e12 E/h auto "converges" off the reference: the pressure carries a
-    round-off of eps r g (about 15 % of p), so F_t = 1.013 mu N (measured).
+    round-off of eps r g (about 15 % of p), so F_t misses mu N by about 1 %
+    (measured 1.013 and 0.993 with two builds of the libraries: the sign is the
+    round-off's).
     """
     with pytest.raises(SystemExit):
         main(["stability", "--help"])
@@ -97,4 +99,5 @@ def test_stability_two_body_friction_records_coulomb_ratio_and_reference(tmp_pat
     gnrm, auto = rows[("blocks-r1e12", "gnrm")], rows[("blocks-r1e12", "auto")]
     assert gnrm["status"] == "diverged" and gnrm["reference_reached"] == "False"
     assert auto["status"] == "converged" and auto["reference_reached"] == "False"
-    assert 1e-3 < float(auto["reference_deviation"]) < 1e-2 and float(auto["ft_ratio"]) > 1.005
+    assert 1e-3 < float(auto["reference_deviation"]) < 1e-2
+    assert 0.005 < abs(float(auto["ft_ratio"]) - 1.0) < 0.03

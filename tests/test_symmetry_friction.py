@@ -125,9 +125,9 @@ def test_a_failed_linear_solve_is_a_status_not_a_petsc_error(tmp_path, monkeypat
     (A KSP solve that stops with an error left the residual vector locked, and
     the next assembly died with PETSc's "error code 73".)
     """
-    import fenics_contact.model.friction as friction
+    import fenics_contact.model.friction_terms as friction_terms
 
-    monkeypatch.setattr(friction, "symmetry_planes", lambda domain, conditions: [])
+    monkeypatch.setattr(friction_terms, "symmetry_planes", lambda domain, conditions: [])
     path = tmp_path / "half.toml"
     path.write_text(HEAD.format(name="half", origin="[0.0, 0.0, 0.0]", size="[1.0, 0.5, 0.5]",
                                 cells="[4, 2, 2]", steps=4)

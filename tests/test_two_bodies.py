@@ -10,8 +10,12 @@ from mpi4py import MPI
 
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import material
-from fenics_contact.model.pairs import Body, TwoBodyProblem
-from fenics_contact.model.problem import PrescribedDisplacement
+from fenics_contact.model.problem import (
+    Body,
+    ContactProblem,
+    PrescribedDisplacement,
+    two_body_problem,
+)
 from fenics_contact.model.search import SurfaceSearch
 from fenics_contact.scene import two_body_meshing as tbm
 from fenics_contact.solvers import make_strategy
@@ -73,7 +77,7 @@ def test_search_matches_brute_force() -> None:
 
 
 # -- problems --------------------------------------------------------------------------
-def _blocks(n_upper: int, n_lower: int, r: float = 1.0) -> tuple[TwoBodyProblem, MeshTags]:
+def _blocks(n_upper: int, n_lower: int, r: float = 1.0) -> tuple[ContactProblem, MeshTags]:
     md = BlockOnBlock(n_upper, n_lower).mesh()
     return linear_pair(md, ContactSettings(r=r), BlockOnBlock.FIXED), md.facet_tags
 
@@ -142,7 +146,7 @@ def test_strategies_on_two_bodies(method: str, r: float) -> None:
         assert abs(state.contact_force - 2.1941563995900544) < 1e-7
 
 
-def _cylinders(h: float, r: float) -> TwoBodyProblem:
+def _cylinders(h: float, r: float) -> ContactProblem:
     return TwoCylinders(h_contact=h, push=0.02).build(ContactSettings(r=r))
 
 
@@ -208,7 +212,7 @@ def test_ironing_short() -> None:
     bodies = [Body("indenter", tbm.STRIKER_TAG, material("neo-hookean", 1000.0, 0.3)),
               Body("block", tbm.TARGET_TAG, material("neo-hookean", 100.0, 0.3))]
     path = ((0.0, 0.0, 0.0), (0.2, 0.0, -0.1), (1.0, 0.6, -0.1))
-    problem = TwoBodyProblem(
+    problem = two_body_problem(
         md.mesh, md.cell_tags, bodies, ft.find(tbm.STRIKER_FACE_TAG),
         ft.find(tbm.TARGET_FACE_TAG), ContactSettings(r=1.0),
         prescribed=[PrescribedDisplacement(ft.find(tbm.SUPPORT_TAG), (0.0, 0.0)),
@@ -324,14 +328,14 @@ def test_two_body_problem_errors() -> None:
     bodies = [Body("upper", tbm.STRIKER_TAG, law), Body("lower", tbm.TARGET_TAG, law)]
     s, t = ft.find(tbm.STRIKER_FACE_TAG), ft.find(tbm.TARGET_FACE_TAG)
     with pytest.raises(ValueError, match="share facets"):
-        TwoBodyProblem(md.mesh, md.cell_tags, bodies, s, s, ContactSettings())
+        two_body_problem(md.mesh, md.cell_tags, bodies, s, s, ContactSettings())
     with pytest.raises(ValueError, match="quadrature = 'nodal'"):
-        TwoBodyProblem(md.mesh, md.cell_tags, bodies, s, t, ContactSettings(quadrature="gauss"))
+        two_body_problem(md.mesh, md.cell_tags, bodies, s, t, ContactSettings(quadrature="gauss"))
     with pytest.raises(ValueError, match="cell tag 9"):
-        TwoBodyProblem(md.mesh, md.cell_tags, [bodies[0], Body("x", 9, law)], s, t,
-                       ContactSettings())
+        two_body_problem(md.mesh, md.cell_tags, [bodies[0], Body("x", 9, law)], s, t,
+                         ContactSettings())
     with pytest.raises(ValueError, match="not among the bodies"):
-        TwoBodyProblem(md.mesh, md.cell_tags, bodies, s, t, ContactSettings(), striker="top")
+        two_body_problem(md.mesh, md.cell_tags, bodies, s, t, ContactSettings(), striker="top")
 
 
 def test_stability_grid_two_body_case() -> None:

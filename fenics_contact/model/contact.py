@@ -95,16 +95,19 @@ class ContactSettings:
 
 
 def vertex_measure(
-    domain: mesh.Mesh, tags: mesh.MeshTags, quadrature: Quadrature = "nodal"
+    domain: mesh.Mesh,
+    tags: mesh.MeshTags,
+    quadrature: Quadrature = "nodal",
+    ids: int | tuple[int, ...] = CONTACT_TAG,
 ) -> ufl.Measure:
-    """Surface measure over the contact facets, with the vertex rule for 'nodal'."""
+    """Surface measure over the facets tagged ``ids``, with the vertex rule for 'nodal'."""
     metadata = (
         {"quadrature_rule": "vertex", "quadrature_degree": 1}
         if quadrature == "nodal"
         else {"quadrature_degree": 4}
     )
     return ufl.Measure(
-        "ds", domain=domain, subdomain_data=tags, subdomain_id=CONTACT_TAG, metadata=metadata
+        "ds", domain=domain, subdomain_data=tags, subdomain_id=ids, metadata=metadata
     )
 
 
@@ -129,12 +132,13 @@ class ContactSurface:
         facets: np.ndarray,
         quadrature: Quadrature = "nodal",
         tags: mesh.MeshTags | None = None,
+        ids: int | tuple[int, ...] = CONTACT_TAG,
     ) -> None:
         """Build the submesh and multiplier space.
 
-        ``tags``: facet tags of the whole body in which ``facets`` carry
-        :data:`CONTACT_TAG` (one tag set must serve every ``ds`` of a form);
-        made here when not given.
+        ``tags``: facet tags of the whole mesh in which ``facets`` are those
+        carrying the values ``ids`` (one tag set must serve every ``ds`` of a
+        form, see :func:`~.tags.facet_roles`); made here when not given.
         """
         fdim = domain.topology.dim - 1
         domain.topology.create_connectivity(fdim, domain.topology.dim)
@@ -153,8 +157,8 @@ class ContactSurface:
         )
         self.submesh, self.entity_map, _, self.node_map = mesh.create_submesh(domain, fdim, facets)
         self.Q = fem.functionspace(self.submesh, ("Lagrange", 1))
-        self.ds = vertex_measure(domain, self.tags, quadrature)
-        self.ds_nodal = vertex_measure(domain, self.tags, "nodal")
+        self.ds = vertex_measure(domain, self.tags, quadrature, ids)
+        self.ds_nodal = vertex_measure(domain, self.tags, "nodal", ids)
         self.entity_maps = [self.entity_map]
         size = domain.comm.allreduce(float(np.sum(facet_diameters(domain, facets))), op=MPI.SUM)
         #: Mean size of the candidate contact facets (length units).

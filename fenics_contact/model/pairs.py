@@ -23,46 +23,17 @@ facet. The solver condenses the w_k onto u with the selection w_k = S_k u
 
 from __future__ import annotations
 
-import dataclasses
-from collections.abc import Sequence
-from dataclasses import dataclass
-
 import numpy as np
 import ufl
 from dolfinx import fem, la, mesh
 
 from mpi4py import MPI
 
-from fenics_contact.model.contact import (
-    ContactSettings,
-    ContactSurface,
-    augmented_lagrangian_energy,
-    augmented_pressure,
-)
-from fenics_contact.model.materials import Elastic
-from fenics_contact.model.problem import (
-    ContactProblem,
-    ContactState,
-    PrescribedDisplacement,
-    SurfaceTraction,
-    energy_quadrature_degree,
-)
+from fenics_contact.model.body import Body
+from fenics_contact.model.contact import ContactSettings, ContactSurface
+from fenics_contact.model.contacts import Contact
+from fenics_contact.model.friction import FrictionSettings, tangent_basis
 from fenics_contact.model.search import SurfaceSearch, penetration_depth
-
-
-@dataclass(frozen=True)
-class Body:
-    """One body of a multi-body mesh.
-
-    Attributes:
-        name: label used in outputs.
-        tag: its cell tag in the mesh.
-        material: its constitutive law.
-    """
-
-    name: str
-    tag: int
-    material: Elastic
 
 
 def _node_to_block(V: fem.FunctionSpace) -> np.ndarray:
@@ -297,184 +268,140 @@ class DeformablePair:
         return [self.target_blocks[facet, k] for k in range(self.gdim)]
 
 
-class TwoBodyProblem(ContactProblem):
-    """Several bodies in one mesh and one striker/target contact pair.
+class NodeToSegmentContact(Contact):
+    """A striker surface of the solid against a target surface of another of its bodies.
 
-    Same API as :class:`ContactProblem` (the systems carry the target's
-    vertex displacements as extra unknowns for the condensing kernel).
-    ``r`` relative to E/h uses E = 2 E_s E_t / (E_s + E_t) of the striker's
-    and target's bodies and h of the striker facets.
+    One-pass node-to-segment: each striker node is projected on its closest
+    target facet (:class:`DeformablePair`). ``r`` relative to E/h uses the
+    pair modulus E = 2 E_s E_t / (E_s + E_t) of the striker's and target's
+    bodies and h of the striker facets.
+
+    Args:
+        striker_facets: local facet indices of the striker surface (they carry lam).
+        target_facets: local facet indices of the target surface.
+        settings: r, its scale; the quadrature must be 'nodal'.
+        striker: the striker's body (default: the body whose cells carry its facets).
+        target: the target's body (likewise).
+        friction: Coulomb friction (None: frictionless); see :meth:`slip_increment`.
+        name: label in outputs.
     """
 
     def __init__(
         self,
-        domain: mesh.Mesh,
-        cell_tags: mesh.MeshTags,
-        bodies: Sequence[Body],
         striker_facets: np.ndarray,
         target_facets: np.ndarray,
         settings: ContactSettings,
         *,
         striker: str | None = None,
         target: str | None = None,
-        prescribed: Sequence[PrescribedDisplacement] = (),
-        tractions: Sequence[SurfaceTraction] = (),
-        degree: int = 1,
+        friction: FrictionSettings | None = None,
+        name: str = "pair",
     ) -> None:
-        gdim = domain.geometry.dim
-        if domain.topology.dim != gdim:
-            raise ValueError("The mesh's topological and geometric dimensions must agree.")
-        if degree != 1:
-            raise ValueError(
-                f"Two-body contact needs degree = 1 (vertex node-to-segment), got {degree}."
-            )
         if settings.quadrature != "nodal":
             raise ValueError(
                 "Two-body contact is node-to-segment: use quadrature = 'nodal', "
                 f"got {settings.quadrature!r}."
             )
-        if not bodies:
-            raise ValueError("Give at least one body.")
-        tags = [b.tag for b in bodies]
-        if len(set(tags)) != len(tags):
-            raise ValueError(f"Body cell tags {tags} repeat; give each body its own tag.")
-        present = set(np.unique(cell_tags.values).tolist())
-        present = set().union(*domain.comm.allgather(present))
-        for b in bodies:
-            if b.tag not in present:
-                raise ValueError(
-                    f"Body {b.name!r} has cell tag {b.tag}, which no cell of the mesh carries "
-                    f"(tags present: {sorted(present)})."
-                )
-        self.domain = domain
-        self.comm = domain.comm
-        self.cell_tags = cell_tags
-        self.bodies = list(bodies)
-        comm = domain.comm
-        overlap = np.intersect1d(np.asarray(striker_facets), np.asarray(target_facets)).size
-        if comm.allreduce(overlap, op=MPI.SUM):
+        super().__init__(striker_facets, settings, friction=friction, name=name)
+        self.target_facets = np.asarray(target_facets, dtype=np.int32)
+        self._names = (striker, target)
+        self._target_force_forms: list[fem.Form] | None = None
+
+    def _bind_partner(self, solid) -> ufl.core.expr.Expr:
+        if solid.degree != 1:
+            raise ValueError(
+                f"Two-body contact needs degree = 1 (vertex node-to-segment), got {solid.degree}."
+            )
+        overlap = np.intersect1d(self.facets, self.target_facets).size
+        if self.comm.allreduce(overlap, op=MPI.SUM):
             raise ValueError(
                 "The striker and target facet sets share facets; a contact pair needs two "
                 "disjoint surfaces (tag them separately)."
             )
-        s_body = self._body_of(domain, cell_tags, bodies, striker_facets, striker, "striker")
-        t_body = self._body_of(domain, cell_tags, bodies, target_facets, target, "target")
-        Es, Et = s_body.material.E, t_body.material.E
-        self.pair_modulus = 2.0 * Es * Et / (Es + Et)
-        self.material = s_body.material
-        self.obstacle = None
-        self._unknowns(settings, striker_facets, tractions, degree)
-        self._motion = np.zeros(gdim)
-        self.bcs = self._dirichlet(prescribed)
-        self._traction_constants = []
-        external = self._external_work(tractions)
-
-        self.pair = DeformablePair(self.V, self.u, self.surface, target_facets)
-        x = ufl.SpatialCoordinate(domain) + self.u
-        self.gap = self.pair.gap(x)
-        self.pressure = augmented_pressure(self.gap, self.lam, self.r)
-        dx = ufl.Measure("dx", domain=domain, subdomain_data=cell_tags)
-        degrees = {}
-        potential = 0
-        for b in bodies:
-            psi = b.material.strain_energy(self.u)
-            degrees[b.tag] = energy_quadrature_degree(psi, self.u, degree)
-            potential += psi * dx(b.tag, metadata={"quadrature_degree": degrees[b.tag]})
-        self._dx = lambda tag: dx(tag, metadata={"quadrature_degree": degrees[tag]})
-        self._internal_form = None
-        self._target_force_forms: list[fem.Form] | None = None
-        self.potential = potential
-        if external is not None:
-            self.potential -= external
-        self._diagnostic_forms()
+        bodies = [
+            solid.body_of_facets(facets, role) if name is None else _named(solid, name, role)
+            for name, facets, role in zip(self._names, (self.facets, self.target_facets),
+                                          ("striker", "target"), strict=True)
+        ]
+        Es, Et = (b.material.E for b in bodies)
+        self.striker_body, self.target_body = bodies
+        self.modulus = 2.0 * Es * Et / (Es + Et)
+        self.pair = DeformablePair(solid.V, solid.u, self.surface, self.target_facets)
         self.pair.refresh()
+        return self.pair.gap(ufl.SpatialCoordinate(solid.domain) + solid.u)
 
-    @staticmethod
-    def _body_of(domain, cell_tags, bodies, facets, name, role) -> Body:
-        """The body named ``name``, or the one whose cells carry the facets."""
-        if name is not None:
-            found = [b for b in bodies if b.name == name]
-            if not found:
-                raise ValueError(
-                    f"The {role} body {name!r} is not among the bodies "
-                    f"{[b.name for b in bodies]}; use one of those names."
-                )
-            return found[0]
-        tdim = domain.topology.dim
-        domain.topology.create_connectivity(tdim - 1, tdim)
-        f2c = domain.topology.connectivity(tdim - 1, tdim)
-        tag_of = dict(zip(cell_tags.indices.tolist(), cell_tags.values.tolist(), strict=True))
-        local = {tag_of.get(int(c)) for f in np.asarray(facets) for c in f2c.links(int(f))}
-        tags = set().union(*domain.comm.allgather(local)) - {None}
-        matching = [b for b in bodies if b.tag in tags]
-        if len(matching) != 1:
-            raise ValueError(
-                f"The {role} facets border cells of {len(matching)} bodies "
-                f"({[b.name for b in matching]}); a {role} surface lies on one body."
-            )
-        return matching[0]
+    # -- search ---------------------------------------------------------------------
+    def refresh(self) -> bool:
+        """Search and refill the target coefficients when u has changed."""
+        return self.pair.refresh()
 
-    # -- parameters and loads ---------------------------------------------------
+    def extras(self) -> list[fem.Function]:
+        """The target vertex displacements w_k (condensed by w_k = S_k u)."""
+        return list(self.pair.w)
+
     @property
-    def stiffness_scale(self) -> float:
-        """E/h with E the pair modulus 2 E_s E_t / (E_s + E_t) (stress per length)."""
-        return self.pair_modulus / self.surface.h
+    def transfer(self) -> DeformablePair:
+        """The pair: its search, version and selection (see :meth:`DeformablePair.sources`)."""
+        return self.pair
 
-    def set_load(self, t: float) -> None:
-        """Apply the load factor t to the prescribed values and tractions."""
-        self.load_factor = float(t)
-        self._apply_prescribed(t)
-        for const, value in self._traction_constants:
-            const.value[:] = t * value
+    def penetration(self) -> float:
+        """Global depth inside the actual target surface (:meth:`DeformablePair.penetration`)."""
+        depth = self.pair.penetration()
+        return self.comm.allreduce(float(np.max(depth, initial=0.0)), op=MPI.MAX)
 
-    def reaction(self, facets: np.ndarray) -> np.ndarray:
-        """Internal nodal force summed over the facets' nodes, per component (force).
+    # -- friction -----------------------------------------------------------------------
+    def slip_increment(self, u_prev: fem.Function) -> tuple[ufl.core.expr.Expr, ufl.core.expr.Expr]:
+        """T of the target facet and the relative slip of the contacting points.
 
-        With prescribed displacements on those facets this is the force the
-        support exerts on the body (per unit thickness in 2D); tractions on
-        the same facets are not included.
+        dg_t = T^T [(x_s - x_s_prev) - (x_p - x_p_prev)] with x_p = sum_k N_k x_k
+        at the current projection (same xi then and now), so the reference
+        positions cancel: dg_t = T^T [(u - u_prev) - sum_k N_k (w_k - w_k_prev)].
+        w_k_prev, the previous displacements of the assigned vertices, are
+        data filled by the search from u_prev. Under a common rigid
+        translation dg_t = 0 and its derivative vanishes, so the friction
+        forces on the striker and on the target balance exactly.
         """
-        if self._internal_form is None:
-            v = ufl.TestFunction(self.V)
-            psi = None
-            for b in self.bodies:
-                term = b.material.strain_energy(self.u) * self._dx(b.tag)
-                psi = term if psi is None else psi + term
-            self._internal_form = fem.form(ufl.derivative(psi, self.u, v))
-        vec = fem.assemble_vector(self._internal_form)
-        vec.scatter_reverse(la.InsertMode.add)
-        gdim = self.domain.geometry.dim
-        n_owned = self.V.dofmap.index_map.size_local
-        out = np.zeros(gdim)
-        for i in range(gdim):
-            dofs = fem.locate_dofs_topological(self.V.sub(i), gdim - 1, facets)
-            dofs = dofs[dofs < n_owned * gdim]
-            out[i] = vec.array[dofs].sum()
-        return self.comm.allreduce(out, op=MPI.SUM)
+        pair = self.pair
+        w_prev = pair.track_previous(u_prev)
+        u = self.solid.u
+        x_s = ufl.SpatialCoordinate(self.domain) + u
+        tangents = tangent_basis(pair.normal(), self.gdim)
+        target = sum(
+            (N * (wk - wk_prev)
+             for N, wk, wk_prev in zip(pair.shape_weights(x_s), pair.w, w_prev, strict=True)),
+            ufl.zero(self.gdim),
+        )
+        return tangents, tangents.T * ((u - u_prev) - target)
 
-    def _contact_residual(self, wk: fem.Function, q: ufl.Argument) -> ufl.Form:
-        """dL_c/dw_k[q] of the contact term (the force on the k-th facet vertex, negated)."""
-        term = augmented_lagrangian_energy(self.gap, self.lam, self.r) * self.surface.ds
-        return ufl.derivative(term, wk, q)
+    def commit_frame(self) -> None:
+        """w_k_prev <- the assigned vertices' displacements in the new u_prev."""
+        if self.friction is not None:
+            self.pair.set_previous()
 
+    # -- the force on the target ------------------------------------------------------------
     def target_force(self) -> fem.Function:
         """Contact force the striker puts on the target's vertices (force per node).
 
-        f_target = sum_k S_k^T dL_c/dw_k with L_c the contact term: the
-        node-to-segment transfer, (1 - xi) and xi of each striker node's
-        force on its facet's vertices in 2D. Zero off the target surface.
+        f_target = sum_k S_k^T dL_c/dw_k with L_c the contact term (normal and
+        tangential): the node-to-segment transfer, (1 - xi) and xi of each
+        striker node's force on its facet's vertices in 2D. Zero off the
+        target surface.
         """
         if self._target_force_forms is None:
             q = ufl.TestFunction(self.pair.W)
-            self._target_force_forms = [
-                fem.form(self._contact_residual(wk, q), entity_maps=self.surface.entity_maps)
-                for wk in self.pair.w
-            ]
+            forms = []
+            for wk in self.pair.w:
+                form = ufl.derivative(self.lagrangian(), wk, q)
+                if self.friction is not None:
+                    form += self.friction.work(self.friction.traction_t, wk, q)
+                forms.append(fem.form(form, entity_maps=self.surface.entity_maps))
+            self._target_force_forms = forms
         self.pair.refresh()
         from petsc4py import PETSc
 
-        gdim = self.domain.geometry.dim
-        im = self.V.dofmap.index_map
+        V = self.solid.V
+        gdim = self.gdim
+        im = V.dofmap.index_map
         vec = PETSc.Vec().createMPI((im.size_local * gdim, im.size_global * gdim),
                                     bsize=gdim, comm=self.comm)
         vec.set(0.0)
@@ -485,57 +412,19 @@ class TwoBodyProblem(ContactProblem):
             vec.setValuesBlocked(src.astype(PETSc.IntType), values, addv=PETSc.InsertMode.ADD)
         vec.assemblyBegin()
         vec.assemblyEnd()
-        out = fem.Function(self.V, name="target_contact_force")
+        out = fem.Function(V, name="target_contact_force")
         out.x.array[: im.size_local * gdim] = -vec.getArray(readonly=True)
         out.x.scatter_forward()
         vec.destroy()
         return out
 
-    def laws(self) -> list[tuple[Elastic, np.ndarray | None]]:
-        """Each body's law and the cells it holds."""
-        return [(b.material, self.cell_tags.find(b.tag)) for b in self.bodies]
 
-    def body_ids(self) -> fem.Function:
-        """Cell-wise body index (0, 1, ...) in the order of ``bodies`` (DG0)."""
-        D = fem.functionspace(self.domain, ("DG", 0))
-        f = fem.Function(D, name="body_id")
-        for i, b in enumerate(self.bodies):
-            cells = self.cell_tags.find(b.tag)
-            f.x.array[D.dofmap.list[cells].reshape(-1)] = float(i)
-        f.x.scatter_forward()
-        return f
-
-    # -- systems -----------------------------------------------------------------
-    def _extra_unknowns(self) -> list[fem.Function]:
-        """The target vertex displacements w_k (condensed by w_k = S_k u)."""
-        return list(self.pair.w)
-
-    # -- diagnostics (search first: u may have moved since the last assembly) -----
-    def refresh_search(self) -> None:
-        """Search and refill the target coefficients when u has changed."""
-        self.pair.refresh()
-
-    def contact_state(self) -> ContactState:
-        """Nodal gaps, pressures and global summaries at the current u (fresh search).
-
-        The max penetration is measured against the actual target surface
-        (:meth:`DeformablePair.penetration`), so the Signorini check and the
-        report see a node that sits inside the target past the end of its facet.
-        """
-        self.pair.refresh()
-        state = super().contact_state()
-        depth = self.pair.penetration()
-        deepest = self.comm.allreduce(float(np.max(depth, initial=0.0)), op=MPI.MAX)
-        return dataclasses.replace(
-            state, max_penetration=deepest, constraint_penetration=state.max_penetration
+def _named(solid, name: str, role: str) -> Body:
+    """The body named ``name`` (ValueError naming the choices)."""
+    found = [b for b in solid.bodies if b.name == name]
+    if not found:
+        raise ValueError(
+            f"The {role} body {name!r} is not among the bodies "
+            f"{[b.name for b in solid.bodies]}; use one of those names."
         )
-
-    def active_signature(self) -> tuple[bytes, ...]:
-        """Fingerprint of the active set at the current u (fresh search)."""
-        self.pair.refresh()
-        return super().active_signature()
-
-    def update_multiplier(self) -> None:
-        """Uzawa update at the current u (fresh search)."""
-        self.pair.refresh()
-        super().update_multiplier()
+    return found[0]

@@ -1,10 +1,18 @@
-"""A hyperelastic body against a rigid obstacle: unknowns, loads and UFL forms.
+"""A contact problem: a solid (bodies in one mesh) and a list of contacts.
 
-The problem owns the displacement ``u`` (vector P-k on the body), the
-multiplier ``lam`` (P1 on the contact submesh), the load factor and the
-parameter ``r``; it hands solvers :class:`VariationalSystem` objects (UFL
-residual blocks with their unknowns) and never imports a solver itself.
-All loads are proportional to one load factor ``t`` in [0, 1].
+The problem owns nothing but the composition: the displacement ``u`` and
+the conditions belong to the :class:`~.body.Solid`, each contact
+(:mod:`.obstacle_contact`, :mod:`.pairs`) owns its multiplier ``lam`` (P1
+on its contact submesh), its parameter ``r`` and its friction. The problem
+hands solvers :class:`VariationalSystem` objects (UFL residual blocks with
+their unknowns: u, every contact's lam, every frictional contact's lam_t,
+then the deformable targets' extras) and never imports a solver itself. All
+loads are proportional to one load factor ``t`` in [0, 1].
+
+Solvers see one system and one set of answers (the state, the active
+pattern, the multiplier update, the checks) whatever the contacts are; the
+accessors that name one contact's objects (``lam``, ``surface``, ...) are
+those of the first contact.
 """
 
 from __future__ import annotations
@@ -14,140 +22,40 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import ufl
-import ufl.algorithms
-from dolfinx import default_scalar_type, fem, mesh
+from dolfinx import fem, mesh
 
-from mpi4py import MPI
-
-from fenics_contact.model.contact import (
-    CONTACT_TAG,
-    ContactSettings,
-    ContactSurface,
-    augmented_lagrangian_energy,
-    augmented_pressure,
-    check_r,
-    penalty_energy,
+from fenics_contact.model.body import (
+    Body,
+    DetFMinimum,
+    PathDisplacement,
+    PrescribedDisplacement,
+    Solid,
+    SurfaceTraction,
+    energy_quadrature_degree,
 )
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.model.contacts import Contact
+from fenics_contact.model.friction import FrictionSettings
 from fenics_contact.model.materials import Elastic
+from fenics_contact.model.obstacle_contact import ObstacleContact
 from fenics_contact.model.obstacles import RigidObstacle
-
-
-@dataclass(frozen=True)
-class PrescribedDisplacement:
-    """Displacement imposed on facets, proportional to the load factor.
-
-    Attributes:
-        facets: facet indices (local) where the condition holds.
-        value: final displacement per component (length units); ``None``
-            leaves that component free.
-    """
-
-    facets: np.ndarray
-    value: tuple[float | None, ...]
-
-    def at(self, t: float) -> tuple[float | None, ...]:
-        """Displacement per component at load factor t (None: free)."""
-        return tuple(None if v is None else t * float(v) for v in self.value)
-
-
-@dataclass(frozen=True)
-class PathDisplacement(PrescribedDisplacement):
-    """A prescribed displacement along a piecewise-linear path in the load factor.
-
-    Attributes:
-        path: knots (t, u_1, ..., u_d), t increasing from 0 to 1 (length units);
-            every component is prescribed and ``value`` (the end point) is unused.
-    """
-
-    path: tuple[tuple[float, ...], ...] = ()
-
-    def at(self, t: float) -> tuple[float | None, ...]:
-        """Displacement at load factor t (linear between knots)."""
-        knots = np.asarray(self.path, float)
-        return tuple(float(np.interp(t, knots[:, 0], knots[:, 1 + i]))
-                     for i in range(knots.shape[1] - 1))
-
-
-@dataclass(frozen=True)
-class SurfaceTraction:
-    """Traction on facets per unit reference area, proportional to the load factor."""
-
-    facets: np.ndarray
-    value: tuple[float, ...]
-
-
-def _schedule(
-    rows: Sequence[Sequence[float]] | None, gdim: int
-) -> tuple[np.ndarray, np.ndarray] | None:
-    """Validate a piecewise-linear obstacle schedule: rows (t, offset...), t from 0 to 1."""
-    if rows is None:
-        return None
-    table = np.asarray(rows, dtype=float)
-    if table.ndim != 2 or table.shape[1] != gdim + 1 or table.shape[0] < 2:
-        raise ValueError(
-            f"An obstacle schedule needs at least two rows of {gdim + 1} numbers "
-            f"(load factor, then the {gdim} offset components); got shape {table.shape}."
-        )
-    times = table[:, 0]
-    if not (np.all(np.isfinite(table)) and times[0] == 0.0 and times[-1] == 1.0
-            and np.all(np.diff(times) > 0)):
-        raise ValueError(
-            f"Obstacle schedule load factors {times.tolist()} must be finite, strictly "
-            "increasing, start at 0 and end at 1."
-        )
-    return times, table[:, 1:]
-
-
-def energy_quadrature_degree(psi: ufl.core.expr.Expr, u: fem.Function, degree: int) -> int:
-    """Quadrature degree for the strain energy and its derivatives.
-
-    UFL's estimate for the tangent, capped at 2 (degree + 1): exact for
-    linear elasticity and St. Venant-Kirchhoff on simplices and for linear
-    elasticity on quadrilaterals/hexahedra, and it keeps non-polynomial
-    laws (neo-Hookean: estimate 17 on hexahedra) affordable.
-    """
-    v = ufl.TestFunction(u.function_space)
-    tangent = ufl.derivative(ufl.derivative(psi * ufl.dx, u, v), u)
-    integrand = ufl.algorithms.expand_derivatives(tangent).integrals()[0].integrand()
-    estimate = ufl.algorithms.estimate_total_polynomial_degree(integrand)
-    return int(min(estimate, 2 * (degree + 1)))
-
+from fenics_contact.model.state import ContactState, ProblemState, combined_state
+from fenics_contact.model.tags import facet_roles
 
 #: A non-potential residual term: (coefficient, test function) -> form (or None).
 Work = Callable[[fem.Function, ufl.Argument], ufl.Form]
-
-#: Facet tag of the first traction; the i-th traction has TRACTION_TAG0 + i.
-TRACTION_TAG0 = 100
-
-
-def _facet_tags(
-    domain: mesh.Mesh, contact_facets: np.ndarray, tractions: Sequence[SurfaceTraction]
-) -> mesh.MeshTags:
-    """One facet tag set for every ``ds``: contact facets and each traction's facets."""
-    fdim = domain.topology.dim - 1
-    groups = [(np.unique(np.asarray(contact_facets, np.int32)), CONTACT_TAG)] + [
-        (np.asarray(t.facets, np.int32), TRACTION_TAG0 + i) for i, t in enumerate(tractions)
-    ]
-    facets = np.concatenate([f for f, _ in groups])
-    values = np.concatenate([np.full(f.size, tag, np.int32) for f, tag in groups])
-    if np.unique(facets).size != facets.size:
-        raise ValueError(
-            "A facet is listed twice among the contact surface and the tractions; "
-            "give each facet one role."
-        )
-    order = np.argsort(facets)
-    return mesh.meshtags(domain, fdim, facets[order], values[order])
 
 
 @dataclass
 class VariationalSystem:
     """Residual blocks F_i(unknowns; tests) = 0 and what a solver needs to compile them.
 
-    Two-body systems add ``extras``: coefficients (the target vertex
-    displacements w_k) that are a selection of ``unknowns[0]`` (w_k = S_k u),
-    with one more residual block each after the unknowns' blocks; ``transfer``
-    refreshes them (search) and names the selected blocks (``sources()``,
-    ``version``). A solver condenses them away (solvers/condensed.py).
+    Systems with deformable targets add ``extras``: coefficients (the target
+    vertex displacements w_k) that are a selection of ``unknowns[0]``
+    (w_k = S_k u), with one more residual block each after the unknowns'
+    blocks; ``transfer`` refreshes them (search) and names the selected
+    blocks (``sources()``, ``version``). A solver condenses them away
+    (solvers/condensed.py).
     """
 
     name: str
@@ -159,508 +67,486 @@ class VariationalSystem:
     transfer: object | None = None
 
 
-@dataclass(frozen=True)
-class ProblemState:
-    """A copy of the unknowns and the load factor, for undoing a failed increment.
+class Transfers:
+    """The searches of several deformable contacts seen as one (refresh, version, sources)."""
 
-    Attributes:
-        u: displacement dof values (owned and ghost), length.
-        lam: multiplier dof values (owned and ghost), stress.
-        load_factor: the load factor the state belongs to.
-    """
+    def __init__(self, transfers: Sequence[object]) -> None:
+        self.transfers = list(transfers)
 
-    u: np.ndarray
-    lam: np.ndarray
-    load_factor: float
-
-
-@dataclass(frozen=True)
-class ContactState:
-    """Nodal contact diagnostics at the current iterate.
-
-    Attributes:
-        gap: nodal gaps at the owned multiplier nodes (length).
-        pressure: nodal contact pressure (<= 0, stress): the multiplier for
-            multiplier strategies, r min(g, 0) for the penalty method.
-        multiplier: nodal multiplier lam.
-        active_count: global number of nodes with a pressure < 0.
-        max_penetration: global max of -min(g, 0) (length).
-        contact_force: global normal force -int p dA on the reference surface
-            (force; per unit thickness in 2D). Multiplier strategies report
-            -int lam dA: at convergence lam = p, and lam does not carry the
-            round-off of r g that p carries at huge r (at r = 1e12 E/h a gap
-            of 1e-15 makes r g of order one). The penalty method, whose
-            multiplier is zero, reports -int r min(g, 0) dA.
-        constraint_penetration: two deformable bodies: the max penetration by
-            the discretisation's own gap (to the plane of each node's assigned
-            facet), while ``max_penetration`` is the depth inside the actual
-            target surface; None where the two are one (rigid obstacles).
-        tangential_force: global |int T tau dA| (force); 0 without friction.
-        stick_count: global number of sticking contact nodes (0 without friction).
-        slip_count: global number of slipping contact nodes (0 without friction).
-    """
-
-    gap: np.ndarray
-    pressure: np.ndarray
-    multiplier: np.ndarray
-    active: np.ndarray
-    active_count: int
-    max_penetration: float
-    contact_force: float
-    constraint_penetration: float | None = None
-    tangential_force: float = 0.0
-    stick_count: int = 0
-    slip_count: int = 0
-
-    @classmethod
-    def gathered(
-        cls,
-        comm: MPI.Comm,
-        gap: np.ndarray,
-        pressure: np.ndarray,
-        multiplier: np.ndarray,
-        local_force: float,
-    ) -> ContactState:
-        """The state from this rank's nodal values, with the summaries reduced over ``comm``.
-
-        Args:
-            comm: communicator of the problem.
-            gap: owned nodal gaps (length).
-            pressure: owned nodal pressure (<= 0, stress); active where < 0.
-            multiplier: owned nodal multipliers.
-            local_force: this rank's share of the contact force (force).
-        """
-        active = pressure < 0.0
-        return cls(
-            gap=gap,
-            pressure=pressure,
-            multiplier=multiplier,
-            active=active,
-            active_count=comm.allreduce(int(active.sum()), op=MPI.SUM),
-            max_penetration=comm.allreduce(
-                float(np.max(-np.minimum(gap, 0.0), initial=0.0)) + 0.0, op=MPI.MAX
-            ),
-            contact_force=comm.allreduce(local_force, op=MPI.SUM),
-        )
-
-
-@dataclass(frozen=True)
-class DetFMinimum:
-    """Smallest det F = det(I + grad u) over the body's quadrature points.
-
-    Attributes:
-        value: the global minimum (1 undeformed, <= 0 inverted).
-        where: reference coordinates of the midpoint of the cell holding it
-            (length; 3 entries, z = 0 in 2D).
-    """
-
-    value: float
-    where: tuple[float, float, float]
-
-
-
-class ProblemBase:
-    """What every contact problem shares: r, Dirichlet conditions, snapshots.
-
-    A subclass sets ``domain``, ``V``, ``u``, ``lam``, ``r`` (a Constant),
-    ``load_factor`` and ``stiffness_scale``, and defines ``set_load``.
-    """
-
-    domain: mesh.Mesh
-    V: fem.FunctionSpace
-    u: fem.Function
-    lam: fem.Function
-    r: fem.Constant
-    load_factor: float
-    bcs: list[fem.DirichletBC]
-    _bc_constants: list[tuple[fem.Constant, PrescribedDisplacement, int]]
-    #: Whether the contact carries Coulomb friction (a tangential multiplier lam_t,
-    #: the Coulomb checks, r_t); solvers read this instead of probing the problem.
-    frictional = False
+    def refresh(self) -> bool:
+        """Refresh every search; True when some assignment changed."""
+        changed = [t.refresh() for t in self.transfers]
+        return any(changed)
 
     @property
+    def version(self) -> int:
+        """Grows whenever some search changes an assignment."""
+        return sum(t.version for t in self.transfers)
+
+    def sources(self) -> list[np.ndarray]:
+        """Every contact's selections, in the order of the systems' extras."""
+        return [s for t in self.transfers for s in t.sources()]
+
+
+class ContactProblem:
+    """A solid and its contacts, proportional loading.
+
+    Args:
+        solid: the bodies, their laws and conditions.
+        contacts: the contacts (unbound); each is bound to the solid here.
+    """
+
+    def __init__(self, solid: Solid, contacts: Sequence[Contact]) -> None:
+        if not contacts:
+            raise ValueError("A contact problem needs at least one contact.")
+        names = [c.name for c in contacts]
+        if len(set(names)) != len(names):
+            raise ValueError(f"Contact names {names} repeat; give each contact its own name.")
+        self.solid = solid
+        self.contacts = list(contacts)
+        self.domain = solid.domain
+        self.comm = solid.comm
+        self.gdim = solid.gdim
+        self.V = solid.V
+        self.u = solid.u
+        self.bcs = solid.bcs
+        self.load_factor = 0.0
+        groups = [c.facets for c in self.contacts] + [t.facets for t in solid.tractions]
+        self.facet_tags, ids = facet_roles(self.domain, groups)
+        for contact, tag_ids in zip(self.contacts, ids, strict=False):
+            contact.bind(solid, self.facet_tags, tag_ids)
+        self.frictional = any(c.frictional for c in self.contacts)
+        self.u_prev = fem.Function(self.V, name="displacement_prev") if self.frictional else None
+        for contact in self.contacts:
+            contact.bind_friction(self.u_prev)
+        self.potential = solid.strain_energy()
+        ds = ufl.Measure("ds", domain=self.domain, subdomain_data=self.facet_tags)
+        external = solid.external_work(ds, ids[len(self.contacts):])
+        if external is not None:
+            self.potential -= external
+        self._multiplier_is_pressure = True
+
+    # -- the first contact's objects ------------------------------------------------
+    @property
+    def contact(self) -> Contact:
+        """The first contact."""
+        return self.contacts[0]
+
+    @property
+    def surface(self):
+        """The first contact's surface (its h, quadrature and submesh)."""
+        return self.contact.surface
+
+    @property
+    def settings(self) -> ContactSettings:
+        """The first contact's settings."""
+        return self.contact.settings
+
+    @property
+    def lam(self) -> fem.Function:
+        """The multiplier of the only contact (several contacts: see :meth:`multipliers`)."""
+        if len(self.contacts) != 1:
+            raise AttributeError(
+                f"The problem has {len(self.contacts)} contacts; read each one's lam from "
+                "problem.contacts or all of them from problem.multipliers()."
+            )
+        return self.contact.lam
+
+    @property
+    def Q(self) -> fem.FunctionSpace:
+        """The first contact's multiplier space."""
+        return self.contact.Q
+
+    @property
+    def obstacle(self) -> RigidObstacle | None:
+        """The first contact's rigid obstacle, None for a deformable pair."""
+        return getattr(self.contact, "obstacle", None)
+
+    @property
+    def pair(self):
+        """The first contact's node-to-segment pair, None against a rigid obstacle."""
+        return getattr(self.contact, "pair", None)
+
+    @property
+    def material(self) -> Elastic:
+        """The first body's law."""
+        return self.solid.stiffest
+
+    def _friction(self):
+        frictional = [c.friction for c in self.contacts if c.friction is not None]
+        if not frictional:
+            raise AttributeError("The problem has no frictional contact.")
+        return frictional
+
+    @property
+    def lam_t(self) -> fem.Function:
+        """The first frictional contact's tangential multiplier."""
+        return self._friction()[0].lam_t
+
+    @property
+    def mu(self) -> fem.Constant:
+        """The first frictional contact's friction coefficient (a Constant)."""
+        return self._friction()[0].mu
+
+    @property
+    def friction_coefficient(self) -> float:
+        """The first frictional contact's mu (dimensionless)."""
+        return float(self.mu.value)
+
+    @property
+    def contact_extent(self) -> float:
+        """Extent L of the first frictional contact's surface (length)."""
+        return self._friction()[0].contact_extent
+
+    @property
+    def symmetry_constraints(self) -> int:
+        """Tangential components held at 0 by symmetry planes, over every contact."""
+        return sum(f.symmetry_constraints for f in self._friction())
+
+    # -- unknowns ----------------------------------------------------------------------
+    def normal_multipliers(self) -> list[fem.Function]:
+        """Each contact's lam (<= 0, the pressure), in the order of the contacts."""
+        return [c.lam for c in self.contacts]
+
+    def multipliers(self) -> list[fem.Function]:
+        """Every multiplier: each contact's lam, then each frictional contact's lam_t."""
+        return self.normal_multipliers() + [f.lam_t for f in self._frictions()]
+
+    @property
+    def multiplier_is_pressure(self) -> bool:
+        """Whether lam is the pressure of the solution (False once the penalty method solves)."""
+        return self._multiplier_is_pressure
+
+    @multiplier_is_pressure.setter
+    def multiplier_is_pressure(self, value: bool) -> None:
+        self._multiplier_is_pressure = bool(value)
+        for c in self.contacts:
+            c.multiplier_is_pressure = bool(value)
+
+    # -- parameters and loads -------------------------------------------------------------
+    @property
     def stiffness_scale(self) -> float:
-        """The scale that makes r dimensionless (stress per length)."""
-        raise NotImplementedError
-
-    def set_load(self, t: float) -> None:
-        """Apply the load factor t."""
-        raise NotImplementedError
-
-    def commit(self) -> None:
-        """Accept the current state as converged (history-dependent terms; none here)."""
+        """E/h of the first contact: the scale that makes r dimensionless (stress/length)."""
+        return self.contact.stiffness_scale
 
     def set_r(self, r: float, *, relative: bool) -> None:
-        """Set the penalty/augmentation parameter, relative to E/h or absolute."""
-        check_r(r)
-        self.r.value = r * self.stiffness_scale if relative else r
+        """Set every contact's r, relative to its own E/h or absolute (stress/length)."""
+        for c in self.contacts:
+            c.set_r(r, relative=relative)
+
+    @property
+    def r(self) -> fem.Constant:
+        """The first contact's r (a Constant, stress per length)."""
+        return self.contact.r
 
     @property
     def r_absolute(self) -> float:
-        """R in stress per length."""
-        return float(self.r.value)
+        """The first contact's r in stress per length."""
+        return float(self.contact.r.value)
 
     @property
     def r_relative(self) -> float:
-        """R divided by E/h."""
+        """The first contact's r divided by its E/h."""
         return self.r_absolute / self.stiffness_scale
 
-    def _dirichlet(self, prescribed: Sequence[PrescribedDisplacement]) -> list[fem.DirichletBC]:
-        """One Dirichlet condition per prescribed component, valued by :meth:`_apply_prescribed`."""
-        fdim = self.domain.topology.dim - 1
-        self._bc_constants = []
-        bcs = []
-        for condition in prescribed:
-            components = condition.at(1.0)
-            if len(components) != self.domain.geometry.dim:
-                raise ValueError(
-                    f"Prescribed displacement {condition.value} needs one entry per "
-                    f"component ({self.domain.geometry.dim}); use None for a free one."
-                )
-            for i, value in enumerate(components):
-                if value is None:
-                    continue
-                Vi = self.V.sub(i)
-                dofs = fem.locate_dofs_topological(Vi, fdim, condition.facets)
-                const = fem.Constant(self.domain, default_scalar_type(0.0))
-                self._bc_constants.append((const, condition, i))
-                bcs.append(fem.dirichletbc(const, dofs, Vi))
-        return bcs
+    def set_load(self, t: float) -> None:
+        """Apply the load factor t: prescribed values, tractions and obstacle motions."""
+        self.load_factor = float(t)
+        self.solid.set_load(t)
+        for c in self.contacts:
+            c.set_load(t)
 
-    def _apply_prescribed(self, t: float) -> None:
-        """Set every prescribed component to its value at load factor t."""
-        for const, condition, i in self._bc_constants:
-            const.value = condition.at(t)[i]
+    def obstacle_offset(self, t: float) -> np.ndarray:
+        """The first contact's obstacle displacement at load factor t."""
+        return self.contact.offset(t)
 
-    def prescribed_mismatch(self) -> float:
-        """Largest |u - u_D| over the prescribed components at the current load factor (length).
+    def refresh_search(self) -> None:
+        """Bring data that follow u up to date (every deformable contact's search)."""
+        for c in self.contacts:
+            c.refresh()
 
-        Global over ranks. Zero once a Newton step has been taken at this load
-        factor (the Dirichlet rows are linear); the increment of the
-        prescribed values before the first step of a load step.
+    def commit(self) -> None:
+        """Accept the converged increment: u_prev <- u and each contact's slip reference.
+
+        When the penalty method solves the problem (``multiplier_is_pressure``
+        False) the committed tangential traction is kept in lam_t (the
+        regularised-stick history); AL methods already hold it there, and so
+        does ``auto`` after a penalty warm start (it only borrows the system).
         """
-        local = 0.0
-        for (const, _, _), bc in zip(self._bc_constants, self.bcs, strict=True):
-            dofs, n_owned = bc.dof_indices()
-            values = self.u.x.array[dofs[:n_owned]]
-            local = max(local, float(np.max(np.abs(values - float(const.value)), initial=0.0)))
-        return self.comm.allreduce(local, op=MPI.MAX)
-
-    def min_det_F(self) -> DetFMinimum:
-        """Smallest det F over the body (quadrature points of degree 2, all ranks).
-
-        The points are those of a degree-2 rule on the cell, where the strain
-        energy is integrated; one compiled expression per problem.
-        """
-        if not hasattr(self, "_det_expr"):
-            import basix
-
-            cell = self.domain.basix_cell()
-            points, _ = basix.make_quadrature(cell, 2)
-            F = ufl.Identity(self.domain.geometry.dim) + ufl.grad(self.u)
-            self._det_expr = fem.Expression(ufl.det(F), points)
-            self._det_cells = np.arange(
-                self.domain.topology.index_map(self.domain.topology.dim).size_local,
-                dtype=np.int32,
-            )
-        if self._det_cells.size:
-            values = self._det_expr.eval(self.domain, self._det_cells)
-            per_cell = values.reshape(self._det_cells.size, -1).min(axis=1)
-        else:  # a rank without cells
-            per_cell = np.zeros(0)
-        if per_cell.size:
-            worst = int(np.argmin(per_cell))
-            local = float(per_cell[worst])
-            where = mesh.compute_midpoints(
-                self.domain, self.domain.topology.dim, self._det_cells[worst : worst + 1]
-            )[0]
-        else:
-            local, where = np.inf, np.zeros(3)
-        if not np.isfinite(local):
-            local = -np.inf if np.isnan(local) else local
-        value, rank = self.comm.allreduce((local, self.comm.rank), op=MPI.MINLOC)
-        where = self.comm.bcast(np.asarray(where, float), root=rank)
-        return DetFMinimum(float(value), (float(where[0]), float(where[1]), float(where[2])))
-
+        if not self.frictional:
+            return
+        if not self.multiplier_is_pressure:
+            for f in self._friction():
+                f.keep_penalty_traction()
+        self.u_prev.x.array[:] = self.u.x.array
+        for c in self.contacts:
+            c.commit_frame()
 
     def snapshot(self) -> ProblemState:
-        """Copy the unknowns and the load factor (see :meth:`restore`)."""
-        return ProblemState(self.u.x.array.copy(), self.lam.x.array.copy(), self.load_factor)
+        """Copy u, every multiplier and the load factor (see :meth:`restore`)."""
+        return ProblemState(
+            self.u.x.array.copy(),
+            tuple(m.x.array.copy() for m in self.multipliers()),
+            self.load_factor,
+        )
 
     def restore(self, state: ProblemState, *, load: bool = True) -> None:
         """Put back a :meth:`snapshot`; ``load=False`` keeps the current load factor."""
         self.u.x.array[:] = state.u
-        self.lam.x.array[:] = state.lam
+        for m, values in zip(self.multipliers(), state.multipliers, strict=True):
+            m.x.array[:] = values
         if load:
             self.set_load(state.load_factor)
 
+    # -- systems handed to solvers ------------------------------------------------------------
+    def _system(self, name: str, energy: ufl.Form, *, with_lam: bool,
+                tangential: Callable | None = None) -> VariationalSystem:
+        """Residual blocks from an energy plus the friction work.
 
-
-class ContactProblem(ProblemBase):
-    """One deformable body, one rigid obstacle, proportional loading."""
-
-    #: Whether lam is the contact pressure of the solution (the penalty method
-    #: sets False): chooses the contact-force formula.
-    multiplier_is_pressure = True
-
-    def __init__(
-        self,
-        domain: mesh.Mesh,
-        material: Elastic,
-        obstacle: RigidObstacle,
-        contact_facets: np.ndarray,
-        settings: ContactSettings,
-        *,
-        prescribed: Sequence[PrescribedDisplacement] = (),
-        tractions: Sequence[SurfaceTraction] = (),
-        obstacle_motion: Sequence[float] | None = None,
-        obstacle_schedule: Sequence[Sequence[float]] | None = None,
-        degree: int = 1,
-    ) -> None:
-        gdim = domain.geometry.dim
-        if domain.topology.dim != gdim:
-            raise ValueError(
-                f"The body mesh is {domain.topology.dim}D in {gdim}D space; "
-                "use a mesh whose topological and geometric dimensions agree."
-            )
-        self.domain = domain
-        self.comm = domain.comm
-        self.material = material
-        self.obstacle = obstacle
-        self._unknowns(settings, contact_facets, tractions, degree)
-
-        self._motion = (
-            np.zeros(gdim) if obstacle_motion is None else np.asarray(obstacle_motion, float)
-        )
-        self._schedule = _schedule(obstacle_schedule, gdim)
-        self.bcs = self._dirichlet(prescribed)
-        self._traction_constants: list[tuple[fem.Constant, np.ndarray]] = []
-        external = self._external_work(tractions)
-
-        x = ufl.SpatialCoordinate(domain) + self.u
-        self.gap = obstacle.gap(x)
-        self.pressure = augmented_pressure(self.gap, self.lam, self.r)
-        psi = material.strain_energy(self.u)
-        dx = ufl.Measure(
-            "dx", domain=domain,
-            metadata={"quadrature_degree": energy_quadrature_degree(psi, self.u, degree)},
-        )
-        self.potential = psi * dx
-        if external is not None:
-            self.potential -= external
-
-        self._diagnostic_forms()
-
-    # -- parameters and loads -------------------------------------------------
-    @property
-    def stiffness_scale(self) -> float:
-        """E/h: the scale that makes r dimensionless (stress per length)."""
-        return self.material.E / self.surface.h
-
-    def set_load(self, t: float) -> None:
-        """Apply the load factor t: prescribed values, tractions and obstacle motion."""
-        self.load_factor = float(t)
-        self._apply_prescribed(t)
-        for const, value in self._traction_constants:
-            const.value[:] = t * value
-        self.obstacle.translate_to(self.obstacle_offset(t))
-
-    def obstacle_offset(self, t: float) -> np.ndarray:
-        """Obstacle displacement at load factor t: t * motion, or the schedule interpolated."""
-        if self._schedule is None:
-            return t * self._motion
-        times, offsets = self._schedule
-        return np.array([np.interp(t, times, offsets[:, i]) for i in range(offsets.shape[1])])
-
-    def refresh_search(self) -> None:
-        """Bring data that follow u up to date (two bodies: the search); none here."""
-
-    def _unknowns(
-        self,
-        settings: ContactSettings,
-        contact_facets: np.ndarray,
-        tractions: Sequence[SurfaceTraction],
-        degree: int,
-    ) -> None:
-        """Displacement space and u, the contact submesh with lam, and r (load factor 0)."""
-        domain = self.domain
-        self.settings = settings
-        self.V = fem.functionspace(domain, ("Lagrange", degree, (domain.geometry.dim,)))
-        self.u = fem.Function(self.V, name="displacement")
-        self.facet_tags = _facet_tags(domain, contact_facets, tractions)
-        self.surface = ContactSurface(
-            domain, contact_facets, settings.quadrature, tags=self.facet_tags
-        )
-        self.Q = self.surface.Q
-        self.lam = fem.Function(self.Q, name="contact_pressure")
-        self.r = fem.Constant(domain, default_scalar_type(1.0))
-        self.set_r(settings.r, relative=settings.relative)
-        self.load_factor = 0.0
-
-    def _diagnostic_forms(self) -> None:
-        """Nodal gap and pressure, and the normal contact force by p_n and by lam."""
-        self._gap_form = self.surface.nodal_form(self.gap)
-        self._pressure_form = self.surface.nodal_form(self.pressure)
-        self._force_form = fem.form(
-            -self.pressure * self.surface.ds, entity_maps=self.surface.entity_maps
-        )
-        self._multiplier_force_form = fem.form(
-            -self.lam * self.surface.ds, entity_maps=self.surface.entity_maps
-        )
-
-    def _external_work(self, tractions: Sequence[SurfaceTraction]) -> ufl.Form | None:
-        if not tractions:
-            return None
-        ds = ufl.Measure("ds", domain=self.domain, subdomain_data=self.facet_tags)
-        work = 0
-        for i, traction in enumerate(tractions):
-            if len(traction.value) != self.domain.geometry.dim:
-                raise ValueError(
-                    f"Traction {traction.value} needs {self.domain.geometry.dim} components."
-                )
-            const = fem.Constant(self.domain, np.zeros(self.domain.geometry.dim))
-            self._traction_constants.append((const, np.asarray(traction.value, float)))
-            work += ufl.dot(const, self.u) * ds(TRACTION_TAG0 + i)
-        return work
-
-    # -- systems handed to solvers -------------------------------------------
-    def _extra_unknowns(self) -> list[fem.Function]:
-        """Coefficients that are a selection of u (two bodies: target displacements)."""
-        return []
-
-    def _system(
-        self,
-        name: str,
-        energy: ufl.Form,
-        *,
-        with_lam: bool,
-        work: Work | None = None,
-        multipliers: Sequence[tuple[fem.Function, ufl.Form]] = (),
-    ) -> VariationalSystem:
-        """Residual blocks from an energy plus non-potential terms.
-
-        The residual of u (and of each extra coefficient c, see
-        :meth:`_extra_unknowns`) is dE/dc[test] + work(c, test); with
-        ``with_lam`` the multiplier block r dE/dlam[mu] (force units) follows
-        u; ``multipliers`` appends further unknowns with their residuals
-        (e.g. the tangential multiplier), before the extras' blocks.
+        The residual of u (and of each extra coefficient c) is
+        dE/dc[test] + sum over frictional contacts of tau . d(dg_t)/dc[test],
+        tau = ``tangential(friction)``; with ``with_lam`` every contact's
+        multiplier block r dE/dlam[mu] (force units) follows u, then every
+        frictional contact's tangential block, before the extras' blocks.
         """
+        frictions = [c.friction for c in self.contacts if c.friction is not None]
 
         def residual(c: fem.Function) -> ufl.Form:
             test = ufl.TestFunction(c.function_space)
             form = ufl.derivative(energy, c, test)
-            extra = None if work is None else work(c, test)
-            return form if extra is None else form + extra
+            if tangential is not None:
+                for f in frictions:
+                    form += f.work(tangential(f), c, test)
+            return form
 
         residuals = [residual(self.u)]
         unknowns = [self.u]
         if with_lam:
-            residuals.append(self.r * ufl.derivative(energy, self.lam, ufl.TestFunction(self.Q)))
-            unknowns.append(self.lam)
-        for function, form in multipliers:
-            residuals.append(form)
-            unknowns.append(function)
-        extras = self._extra_unknowns()
-        residuals += [residual(c) for c in extras]
-        return VariationalSystem(
-            name, residuals, unknowns, self.bcs, self.surface.entity_maps,
-            extras=extras, transfer=getattr(self, "pair", None) if extras else None,
-        )
+            for c in self.contacts:
+                residuals.append(c.r * ufl.derivative(energy, c.lam, ufl.TestFunction(c.Q)))
+                unknowns.append(c.lam)
+            for f in frictions:
+                residuals.append(f.tangential_residual())
+                unknowns.append(f.lam_t)
+        extras = [w for c in self.contacts for w in c.extras()]
+        residuals += [residual(w) for w in extras]
+        transfers = [c.transfer for c in self.contacts if c.transfer is not None]
+        transfer = None
+        if extras:
+            transfer = transfers[0] if len(transfers) == 1 else Transfers(transfers)
+        entity_maps = [m for c in self.contacts for m in c.surface.entity_maps]
+        return VariationalSystem(name, residuals, unknowns, self.bcs, entity_maps,
+                                 extras=extras, transfer=transfer)
 
     def _lagrangian(self) -> ufl.Form:
-        """Pi + int AL density ds (paper eq. 9)."""
-        return self.potential + augmented_lagrangian_energy(
-            self.gap, self.lam, self.r
-        ) * self.surface.ds
+        """Pi + sum over the contacts of int AL density ds (paper eq. 9)."""
+        form = self.potential
+        for c in self.contacts:
+            form = form + c.lagrangian()
+        return form
 
     def _penalty_energy(self) -> ufl.Form:
-        """Pi + int r/2 min(g, 0)^2 ds (paper eq. 7)."""
-        return self.potential + penalty_energy(self.gap, self.r) * self.surface.ds
+        """Pi + sum over the contacts of int r/2 min(g, 0)^2 ds (paper eq. 7)."""
+        form = self.potential
+        for c in self.contacts:
+            form = form + c.penalty()
+        return form
+
+    def _suffix(self) -> str:
+        return "_friction" if self.frictional else ""
 
     def augmented_system(self) -> VariationalSystem:
-        """Alart-Curnier saddle point on (u, lam): the GNRM system.
+        """Alart-Curnier saddle point on (u, lam[, lam_t]): the GNRM system.
 
-        The multiplier block is r dL/dlam = (min(lam + r g, 0) - lam) mu,
-        the complementarity residual in force units.
+        The multiplier blocks are r dL/dlam = (min(lam + r g, 0) - lam) mu
+        and (P(lam_t + r_t dg_t) - lam_t) . mu_t, in force units.
         """
-        return self._system("augmented", self._lagrangian(), with_lam=True)
+        return self._system("augmented" + self._suffix(), self._lagrangian(), with_lam=True,
+                            tangential=lambda f: f.traction_t)
 
     def primal_system(self) -> VariationalSystem:
-        """Equilibrium in u with lam held fixed (the Uzawa inner problem)."""
-        return self._system("primal", self._lagrangian(), with_lam=False)
+        """Equilibrium in u with the multipliers held fixed (the Uzawa inner problem)."""
+        return self._system("primal" + self._suffix(), self._lagrangian(), with_lam=False,
+                            tangential=lambda f: f.traction_t)
 
     def penalty_system(self) -> VariationalSystem:
-        """Penalty regularisation (paper eq. 7) in u only."""
-        return self._system("penalty", self._penalty_energy(), with_lam=False)
+        """Penalty regularisation (paper eq. 7) in u only; friction by regularised stick.
 
-    def complementarity_residual(self) -> ufl.Form:
-        """(min(lam + r g, 0) - lam) mu: zero when lam is the converged pressure."""
-        mu = ufl.TestFunction(self.Q)
-        return (self.pressure - self.lam) * mu * self.surface.ds
+        The disc radius is mu r max(-g, 0); lam_t holds the traction committed
+        at the last converged step (updated by :meth:`commit`).
+        """
+        return self._system("penalty" + self._suffix(), self._penalty_energy(), with_lam=False,
+                            tangential=lambda f: f.penalty_traction)
 
-    # -- diagnostics -----------------------------------------------------------
+    def complementarity_residual(self) -> ufl.Form | list[ufl.Form]:
+        """(min(lam + r g, 0) - lam) mu per contact, and the tangential ones (force units).
+
+        One form for one frictionless contact, else a list.
+        """
+        forms = [c.complementarity_residual() for c in self.contacts]
+        forms += [f.tangential_residual() for f in self._frictions()]
+        return forms[0] if len(forms) == 1 else forms
+
+    def _frictions(self) -> list:
+        return [c.friction for c in self.contacts if c.friction is not None]
+
+    # -- diagnostics ---------------------------------------------------------------------
     def contact_state(self) -> ContactState:
-        """Nodal gaps, pressures, the active set and global summaries.
+        """Nodal gaps, pressures, the active set and global summaries (fresh searches).
 
-        With a multiplier method the pressure is the multiplier (see
-        :meth:`nodal_pressure`), so the written field, the active set and the
-        force agree at every r.
+        One contact: its state (with friction, a FrictionalContactState);
+        several: the contacts' states joined (:func:`~.state.combined_state`).
         """
-        gap = self.surface.nodal(self._gap_form)
-        lam = self.lam.x.array[: gap.size].copy()
-        return ContactState.gathered(
-            self.comm, gap, self.nodal_pressure(lam), lam,
-            fem.assemble_scalar(self._contact_force_form()),
-        )
+        return combined_state([c.contact_state() for c in self.contacts])
 
-    def nodal_pressure(self, lam: np.ndarray) -> np.ndarray:
-        """Owned nodal contact pressure (<= 0, stress) of the current iterate.
-
-        Multiplier strategies: the multiplier, min(lam, 0), with values
-        below 1e-12 of the largest pressure set to zero (the round-off of a
-        linear solve at open nodes). The transmitted min(lam + r g, 0) would
-        carry the round-off r * eps * g of the gap, of the order of the
-        pressure itself at r = 1e12 E/h. The penalty method, whose multiplier
-        is zero, transmits r min(g, 0).
-        """
-        if not self.multiplier_is_pressure:
-            return self.surface.nodal(self._pressure_form)
-        pressure = np.minimum(lam, 0.0)
-        peak = self.comm.allreduce(float(np.max(-pressure, initial=0.0)), op=MPI.MAX)
-        pressure[pressure > -1e-12 * peak] = 0.0
-        return pressure
-
-    def _contact_force_form(self) -> fem.Form:
-        """The force from the multiplier when it is the pressure, else from min(lam + r g, 0).
-
-        At huge r the latter carries the round-off r * eps * g of the gap.
-        """
-        by_multiplier = getattr(self, "_multiplier_force_form", None)
-        if self.multiplier_is_pressure and by_multiplier is not None:
-            return by_multiplier
-        return self._force_form
+    def contact_states(self) -> dict[str, ContactState]:
+        """Each contact's state by name."""
+        return {c.name: c.contact_state() for c in self.contacts}
 
     def active_signature(self) -> tuple[bytes, ...]:
-        """A hashable fingerprint of the global active set (lam + r g < 0 at the nodes)."""
-        active = self.surface.nodal(self._pressure_form) < 0.0
-        return tuple(self.comm.allgather(np.packbits(active).tobytes()))
+        """A hashable fingerprint of the global active set (with friction: open/stick/slip)."""
+        local = b"|".join(c.active_pattern() for c in self.contacts)
+        return tuple(self.comm.allgather(local))
 
     def update_multiplier(self) -> None:
-        """Uzawa update lam <- min(lam + r g, 0) at the nodes (paper eq. 10)."""
-        pressure = self.surface.nodal(self._pressure_form)
-        self.lam.x.array[: pressure.size] = pressure
-        self.lam.x.scatter_forward()
+        """Uzawa update of every multiplier at the current iterate (paper eq. 10)."""
+        for c in self.contacts:
+            c.update_multiplier()
+
+    def nodal_pressure(self, lam: np.ndarray) -> np.ndarray:
+        """The first contact's owned nodal pressure for multiplier values ``lam``."""
+        return self.contact.nodal_pressure(lam)
+
+    def nodal_coordinates(self) -> np.ndarray:
+        """Reference coordinates of the owned multiplier nodes of every contact, shape (n, 3)."""
+        return np.concatenate([c.nodal_coordinates() for c in self.contacts])
 
     def laws(self) -> list[tuple[Elastic, np.ndarray | None]]:
-        """Each body's law and its cells (None: every cell): one body here."""
-        return [(self.material, None)]
+        """Each body's law and its cells (None: every cell)."""
+        return self.solid.laws()
 
     def body_ids(self) -> fem.Function | None:
         """Cell-wise body index for the output; None for a single body."""
-        return None
+        return self.solid.body_ids()
 
-    def nodal_coordinates(self) -> np.ndarray:
-        """Reference coordinates of the owned multiplier nodes, shape (n, 3)."""
-        n = self.Q.dofmap.index_map.size_local
-        return self.Q.tabulate_dof_coordinates()[:n]
+    def reaction(self, facets: np.ndarray) -> np.ndarray:
+        """Internal nodal force summed over the facets' nodes (see :meth:`Solid.reaction`)."""
+        return self.solid.reaction(facets)
 
+    def prescribed_mismatch(self) -> float:
+        """Largest |u - u_D| over the prescribed components (length, global)."""
+        return self.solid.prescribed_mismatch()
+
+    def min_det_F(self) -> DetFMinimum:
+        """Smallest det F over the bodies (see :meth:`Solid.min_det_F`)."""
+        return self.solid.min_det_F()
+
+    def target_force(self) -> fem.Function:
+        """Force the first contact's striker puts on its target's vertices (pairs only)."""
+        return self.contact.target_force()
+
+    # -- friction over every frictional contact ----------------------------------------------
+    @property
+    def tangential_r(self) -> float:
+        """The first frictional contact's r_t (stress per length)."""
+        return self._friction()[0].tangential_r
+
+    @property
+    def tangential_cap(self) -> float:
+        """The first frictional contact's cap of r_t (stress per length)."""
+        return self._friction()[0].tangential_cap
+
+    def set_tangential_cap(self, cap: float) -> None:
+        """Set the cap of r_t of every frictional contact (absolute, stress per length)."""
+        for f in self._friction():
+            f.set_tangential_cap(cap)
+
+    def lower_tangential_r(self, factor: float = 0.5) -> float:
+        """Cap r_t at ``factor`` times its current value on every frictional contact.
+
+        The converged nodal answer does not depend on r_t; a smaller r_t keeps
+        the stick/slip guess from flipping (see :mod:`.friction`). Returns the
+        first frictional contact's new r_t (stress per length).
+        """
+        for f in self._friction():
+            f.set_tangential_cap(factor * f.tangential_r)
+        return self.tangential_r
+
+    def tangential_fields(self) -> tuple[np.ndarray, np.ndarray]:
+        """Owned nodal tangential traction on the body and slip, global axes (joined)."""
+        pairs = [f.tangential_fields() for f in self._friction()]
+        return (np.concatenate([p[0] for p in pairs]), np.concatenate([p[1] for p in pairs]))
+
+    def tangential_force_vector(self) -> np.ndarray:
+        """Sum over the frictional contacts of int T tau dA (force): minus the friction."""
+        return sum(f.tangential_force_vector() for f in self._friction())
+
+    def node_states(self) -> np.ndarray:
+        """Per owned node of the frictional contacts: 0 open, 1 stick, 2 slip."""
+        return np.concatenate([f.node_states() for f in self._friction()])
+
+    def coulomb_violations(self) -> tuple[float, float, float]:
+        """Worst nodal violations of the Coulomb conditions over every frictional contact."""
+        worst = [f.coulomb_violations() for f in self._friction()]
+        return tuple(max(w[i] for w in worst) for i in range(3))
+
+    def complementarity_norms(self) -> tuple[float, float]:
+        """Euclidean norms of the normal and tangential complementarity residuals (force)."""
+        squares = [f.complementarity_squares() for f in self._friction()]
+        return (float(np.sqrt(sum(s[0] for s in squares))),
+                float(np.sqrt(sum(s[1] for s in squares))))
+
+
+# -- the two common compositions ---------------------------------------------------------------
+def one_body_problem(
+    domain: mesh.Mesh,
+    material: Elastic,
+    obstacle: RigidObstacle,
+    contact_facets: np.ndarray,
+    settings: ContactSettings,
+    *,
+    prescribed: Sequence[PrescribedDisplacement] = (),
+    tractions: Sequence[SurfaceTraction] = (),
+    obstacle_motion: Sequence[float] | None = None,
+    obstacle_schedule: Sequence[Sequence[float]] | None = None,
+    degree: int = 1,
+    friction: FrictionSettings | None = None,
+) -> ContactProblem:
+    """One deformable body (every cell) against one rigid obstacle."""
+    solid = Solid(domain, [Body("body", None, material)], prescribed=prescribed,
+                  tractions=tractions, degree=degree)
+    contact = ObstacleContact(obstacle, contact_facets, settings, motion=obstacle_motion,
+                              schedule=obstacle_schedule, friction=friction)
+    return ContactProblem(solid, [contact])
+
+
+def two_body_problem(
+    domain: mesh.Mesh,
+    cell_tags: mesh.MeshTags,
+    bodies: Sequence[Body],
+    striker_facets: np.ndarray,
+    target_facets: np.ndarray,
+    settings: ContactSettings,
+    *,
+    striker: str | None = None,
+    target: str | None = None,
+    prescribed: Sequence[PrescribedDisplacement] = (),
+    tractions: Sequence[SurfaceTraction] = (),
+    degree: int = 1,
+    friction: FrictionSettings | None = None,
+) -> ContactProblem:
+    """Bodies of one mesh with one node-to-segment pair (striker against target)."""
+    from fenics_contact.model.pairs import NodeToSegmentContact
+
+    solid = Solid(domain, bodies, cell_tags, prescribed=prescribed, tractions=tractions,
+                  degree=degree)
+    contact = NodeToSegmentContact(striker_facets, target_facets, settings, striker=striker,
+                                   target=target, friction=friction)
+    return ContactProblem(solid, [contact])
+
+
+__all__ = [
+    "Body", "ContactProblem", "ContactState", "PathDisplacement", "PrescribedDisplacement",
+    "ProblemState", "Solid", "SurfaceTraction", "Transfers", "VariationalSystem", "Work",
+    "energy_quadrature_degree", "one_body_problem", "two_body_problem",
+]

@@ -19,11 +19,12 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from fenics_contact.model.friction import SLIP, STICK, FrictionalContactProblem
+from fenics_contact.model.friction import SLIP, STICK
+from fenics_contact.model.problem import ContactProblem
 from fenics_contact.output.plotting import save_figure
 
 
-def friction_profile_data(problem: FrictionalContactProblem) -> dict[str, np.ndarray] | None:
+def friction_profile_data(problem: ContactProblem) -> dict[str, np.ndarray] | None:
     """Gathered nodal data on process 0 (None elsewhere), sorted along the abscissa.
 
     Keys: s (abscissa, length), traction (stress: -tau in 2D, |tau| in 3D),
@@ -42,7 +43,7 @@ def friction_profile_data(problem: FrictionalContactProblem) -> dict[str, np.nda
     return {"s": data[:, 0], "traction": data[:, 1], "limit": data[:, 2], "state": data[:, 3]}
 
 
-def friction_profile(problem: FrictionalContactProblem, path: Path, title: str = "") -> None:
+def friction_profile(problem: ContactProblem, path: Path, title: str = "") -> None:
     """Draw tangential traction and the Coulomb limit +-mu p along the contact surface."""
     data = friction_profile_data(problem)
     if data is None:

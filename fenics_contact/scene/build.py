@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from dolfinx import mesh
@@ -18,18 +18,19 @@ from dolfinx import mesh
 from mpi4py import MPI
 
 from fenics_contact.model.contact import ContactSettings
+from fenics_contact.model.friction import FrictionSettings
 from fenics_contact.model.materials import material
 from fenics_contact.model.obstacles import RigidBall, RigidObstacle, RigidPlane
 from fenics_contact.model.problem import (
+    Body,
     ContactProblem,
     PathDisplacement,
     PrescribedDisplacement,
     SurfaceTraction,
+    one_body_problem,
+    two_body_problem,
 )
 from fenics_contact.model.rigid import free_rigid_motions
-
-if TYPE_CHECKING:
-    from fenics_contact.model.pairs import TwoBodyProblem
 from fenics_contact.scene.checks import (
     SceneWarning,
     check_bodies_held,
@@ -264,10 +265,8 @@ def boundary_conditions(
     return prescribed, tractions
 
 
-def build_two_body_problem(scene: Scene, body: BodyMesh) -> TwoBodyProblem:
+def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
     """Bodies, conditions and the contact pair of a two-body scene (with [[pair]] mu: friction)."""
-    from fenics_contact.model.pairs import Body, TwoBodyProblem
-
     comm = body.domain.comm
     if body.cell_tags is None:
         raise SceneError(
@@ -291,20 +290,13 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> TwoBodyProblem:
     target = tagged_facets(body, scene, "pair target", pair.target)
     check_pair_surfaces(scene, body.domain, body.cell_tags, bodies, striker, target)
     check_bodies_held(scene, body.domain, body.cell_tags, bodies, prescribed)
-    args = (
+    friction = (None if pair.mu is None
+                else FrictionSettings(pair.mu, pair.tangential_r_max))
+    problem = two_body_problem(
         body.domain, body.cell_tags, bodies, striker, target,
         ContactSettings(r=pair.r, relative=pair.relative),
+        prescribed=prescribed, tractions=tractions, friction=friction,
     )
-    problem: TwoBodyProblem
-    if pair.mu is not None:
-        from fenics_contact.model.pair_friction import FrictionalTwoBodyProblem
-
-        problem = FrictionalTwoBodyProblem(
-            *args, mu=pair.mu, tangential_r_max=pair.tangential_r_max,
-            prescribed=prescribed, tractions=tractions,
-        )
-    else:
-        problem = TwoBodyProblem(*args, prescribed=prescribed, tractions=tractions)
     check_initial_overlap(scene, problem)
     return problem
 
@@ -323,28 +315,20 @@ def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProbl
     prescribed, tractions = boundary_conditions(scene, body)
     check_rigid_motions(scene, body, prescribed)
     obstacle = build_obstacle(scene, body.domain)
-    args = (
+    friction = (None if scene.contact.mu is None
+                else FrictionSettings(scene.contact.mu, scene.contact.tangential_r_max))
+    problem = one_body_problem(
         body.domain,
         material(scene.law, scene.E, scene.nu),
         obstacle,
         contact_facets(scene, body, obstacle),
         scene.contact,  # a ContactSettings with the candidate and friction keys
+        prescribed=prescribed,
+        tractions=tractions,
+        obstacle_motion=scene.obstacle.motion,
+        obstacle_schedule=scene.obstacle.schedule or None,
+        friction=friction,
     )
-    options: dict[str, Any] = {
-        "prescribed": prescribed,
-        "tractions": tractions,
-        "obstacle_motion": scene.obstacle.motion,
-        "obstacle_schedule": scene.obstacle.schedule or None,
-    }
-    if scene.contact.mu is not None:
-        from fenics_contact.model.friction import FrictionalContactProblem
-
-        problem: ContactProblem = FrictionalContactProblem(
-            *args, mu=scene.contact.mu, tangential_r_max=scene.contact.tangential_r_max,
-            **options,
-        )
-    else:
-        problem = ContactProblem(*args, **options)
     warn_initial_penetration(scene, problem)
     return problem
 

@@ -22,7 +22,8 @@ from fenics_contact.model.rigid import free_rigid_motions
 from fenics_contact.scene.schema import Scene, SceneError
 
 if TYPE_CHECKING:
-    from fenics_contact.model.pairs import Body, TwoBodyProblem
+    from fenics_contact.model.body import Body
+    from fenics_contact.model.problem import ContactProblem
 
 #: A cell is degenerate when a corner Jacobian's |det| is at most this times its size^dim.
 DEGENERATE = 1e-10
@@ -177,7 +178,7 @@ def check_bodies_held(
             )
 
 
-def check_initial_overlap(scene: Scene, problem: TwoBodyProblem) -> float:
+def check_initial_overlap(scene: Scene, problem: ContactProblem) -> float:
     """Refuse bodies that start inside each other deeper than the striker facet size h.
 
     Only striker nodes whose projection falls on a target facet count. A

@@ -276,7 +276,8 @@ class AutoStrategy(NewtonStrategy):
         p = self.problem
         if self._penalty is None:
             self._penalty = kernel_for(p.penalty_system(), linear=self.linear)
-        p.lam.x.array[:] = 0.0
+        for lam in p.normal_multipliers():
+            lam.x.array[:] = 0.0
         monitor = ConvergenceMonitor(
             replace(settings, rtol=max(settings.rtol, 1e-6)), observer=self._progress(tally)
         )

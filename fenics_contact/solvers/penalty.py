@@ -18,6 +18,7 @@ class Penalty(NewtonStrategy):
 
     def build_system(self, problem: ContactProblem) -> VariationalSystem:
         """The penalised equilibrium; zeroing lam makes diagnostics report r min(g, 0)."""
-        problem.lam.x.array[:] = 0.0
+        for lam in problem.normal_multipliers():
+            lam.x.array[:] = 0.0
         problem.multiplier_is_pressure = False
         return problem.penalty_system()

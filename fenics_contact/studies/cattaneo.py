@@ -15,7 +15,6 @@ import numpy as np
 from mpi4py import MPI
 
 from fenics_contact.model.contact import ContactSettings
-from fenics_contact.model.friction import FrictionalContactProblem
 from fenics_contact.model.problem import ContactProblem
 from fenics_contact.scene.schema import FIELDS, Scene
 from fenics_contact.solvers import make_strategy
@@ -42,7 +41,7 @@ def solve_cattaneo(
     shear_steps: int = 8,
     frictionless_press: bool = True,
     comm: MPI.Comm = MPI.COMM_WORLD,
-) -> tuple[FrictionalContactProblem, list[StickZone], list[int]]:
+) -> tuple[ContactProblem, list[StickZone], list[int]]:
     """Press (frictionless unless told), then shear; measure the stick zone each shear step.
 
     GNRM at r = 0.01 E/h (nodal) unless ``settings`` say otherwise. Returns the

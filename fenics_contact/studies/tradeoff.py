@@ -157,7 +157,7 @@ class FrictionMeter:
     """Measures the friction law at the end of every converged load step (``on_step``).
 
     Attributes:
-        problem: a :class:`~fenics_contact.model.friction.FrictionalContactProblem`.
+        problem: a frictional :class:`~fenics_contact.model.problem.ContactProblem`.
         multiplier: False for the penalty method (no tangential multiplier:
             the complementarity residual is then not measured).
         stick_slip: largest |dg_t| at a node in the stick state (length).

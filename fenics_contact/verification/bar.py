@@ -18,7 +18,11 @@ from fenics_contact.model.candidates import CandidateMode, choose_candidates
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import material
 from fenics_contact.model.obstacles import RigidBall
-from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
+from fenics_contact.model.problem import (
+    ContactProblem,
+    PrescribedDisplacement,
+    one_body_problem,
+)
 from fenics_contact.verification.paper import PAPER_E, PAPER_NU, PAPER_TABLE_2
 
 
@@ -91,7 +95,7 @@ class BarOnCradle:
         )
         cradle = RigidBall(domain, self.cradle_centre(), self.radius, inside=True)
         facets = choose_candidates(domain, cradle, bottom, self.candidates, self.push)
-        return ContactProblem(
+        return one_body_problem(
             domain, material(self.law, self.E, self.nu), cradle, facets, settings,
             prescribed=[PrescribedDisplacement(punch, (0.0, -self.push))],
         )

@@ -34,7 +34,11 @@ from fenics_contact.model.candidates import CandidateMode, choose_candidates
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import material
 from fenics_contact.model.obstacles import RigidPlane
-from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
+from fenics_contact.model.problem import (
+    ContactProblem,
+    PrescribedDisplacement,
+    one_body_problem,
+)
 from fenics_contact.verification.bar import BarOnCradle
 from fenics_contact.verification.hertz_problem import HertzCylinder
 from fenics_contact.verification.paper import PAPER_E, PAPER_NU
@@ -82,7 +86,7 @@ class BlockScene:
 
         plane = RigidPlane(domain, [0.0, 0.0], [0.0, 1.0])
         facets = choose_candidates(domain, plane, side(1, 0.0), self.candidates, self.delta)
-        return ContactProblem(
+        return one_body_problem(
             domain, material(self.law, self.E, self.nu), plane, facets, settings,
             prescribed=[
                 PrescribedDisplacement(side(1, 1.0), (None, -self.delta)),

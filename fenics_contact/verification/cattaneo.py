@@ -35,10 +35,14 @@ from dolfinx import mesh
 from mpi4py import MPI
 
 from fenics_contact.model.contact import ContactSettings
-from fenics_contact.model.friction import OPEN, SLIP, STICK, FrictionalContactProblem
+from fenics_contact.model.friction import OPEN, SLIP, STICK, FrictionSettings
 from fenics_contact.model.materials import LinearElastic
 from fenics_contact.model.obstacles import RigidPlane
-from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
+from fenics_contact.model.problem import (
+    ContactProblem,
+    PrescribedDisplacement,
+    one_body_problem,
+)
 from fenics_contact.scene.meshing import CONTACT_TAG, TOP_TAG, hertz_half_disk
 from fenics_contact.verification.hertz import (
     ContactProfileFit,
@@ -86,7 +90,7 @@ class CattaneoCylinder:
 
     def build(
         self, settings: ContactSettings, comm: MPI.Comm = MPI.COMM_WORLD
-    ) -> FrictionalContactProblem:
+    ) -> ContactProblem:
         """Mesh the half-disk and create the frictional problem (plane on a schedule)."""
         data = hertz_half_disk(
             comm, radius=self.radius, h_contact=self.h_contact, h_far=0.1,
@@ -102,10 +106,10 @@ class CattaneoCylinder:
         schedule = [
             (0.0, 0.0, 0.0), (self.press_until, 0.0, self.push), (1.0, self.shift, self.push)
         ]
-        return FrictionalContactProblem(
+        return one_body_problem(
             domain, LinearElastic(E=self.E, nu=self.nu), plane, band, settings,
             prescribed=[PrescribedDisplacement(top, (0.0, 0.0))],
-            obstacle_schedule=schedule, mu=self.mu, degree=self.degree,
+            obstacle_schedule=schedule, friction=FrictionSettings(self.mu), degree=self.degree,
         )
 
 

@@ -19,7 +19,11 @@ from mpi4py import MPI
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import SaintVenantKirchhoff
 from fenics_contact.model.obstacles import RigidPlane
-from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement, ProblemBase
+from fenics_contact.model.problem import (
+    ContactProblem,
+    PrescribedDisplacement,
+    one_body_problem,
+)
 from fenics_contact.verification.bar import BarOnCradle
 from fenics_contact.verification.paper import PAPER_E, PAPER_NU, PAPER_TABLE_1
 from fenics_contact.verification.striker import StrikerOnFacetProblem
@@ -78,15 +82,15 @@ class _OneElement:
         top = mesh.locate_entities_boundary(domain, 1, lambda x: np.isclose(x[1], 1.0))
         return domain, top
 
-    def corner_displacement(self, problem: ProblemBase) -> float:
+    def corner_displacement(self, problem: ContactProblem | StrikerOnFacetProblem) -> float:
         """Vertical displacement of the corner (1, 1) (the single unknown)."""
         return _corner_displacement(problem.V, problem.u)
 
-    def probe(self, problem: ProblemBase) -> float:
+    def probe(self, problem: ContactProblem | StrikerOnFacetProblem) -> float:
         """What a study reports per run: the corner displacement u."""
         return self.corner_displacement(problem)
 
-    def exact_dofs(self, problem: ProblemBase) -> np.ndarray:
+    def exact_dofs(self, problem: ContactProblem | StrikerOnFacetProblem) -> np.ndarray:
         """Dof values of the exact displacement: only the corner moves."""
         return _corner_dofs(problem.V, self.exact_u)
 
@@ -184,7 +188,7 @@ class WedgeOnCorner(_OneElement):
         """Create the one-element mesh and the contact problem."""
         domain, top = self._unit_square(comm)
         wedge = RigidPlane(domain, [1.0, 1.0], [-self.slope, -1.0])
-        return ContactProblem(
+        return one_body_problem(
             domain,
             SaintVenantKirchhoff(E=PAPER_E, nu=PAPER_NU),
             wedge,

@@ -16,10 +16,14 @@ from dolfinx import mesh
 from mpi4py import MPI
 
 from fenics_contact.model.contact import ContactSettings
-from fenics_contact.model.friction import FrictionalContactProblem
+from fenics_contact.model.friction import FrictionSettings
 from fenics_contact.model.materials import material
 from fenics_contact.model.obstacles import RigidPlane
-from fenics_contact.model.problem import PrescribedDisplacement
+from fenics_contact.model.problem import (
+    ContactProblem,
+    PrescribedDisplacement,
+    one_body_problem,
+)
 
 #: Press up by 0.01 over t = 0 ... 0.4, then slide by 0.02 (the scene's path).
 PRESS_SLIDE = ((0.0, 0.0, 0.0), (0.4, 0.0, 0.01), (1.0, 0.02, 0.01))
@@ -63,7 +67,7 @@ class SlidingBlock:
 
     def build(
         self, settings: ContactSettings, comm: MPI.Comm = MPI.COMM_WORLD
-    ) -> FrictionalContactProblem:
+    ) -> ContactProblem:
         """Mesh, plane on its schedule and the frictional problem."""
         domain = mesh.create_rectangle(
             comm, [np.zeros(2), np.array([self.width, self.height])], [self.nx, self.ny],
@@ -75,9 +79,9 @@ class SlidingBlock:
             domain, fdim, lambda x: np.isclose(x[1], self.height)
         )
         plane = RigidPlane(domain, [0.0, 0.0], [0.0, 1.0])
-        return FrictionalContactProblem(
+        return one_body_problem(
             domain, material("svk", self.E, self.nu), plane, bottom, settings,
             prescribed=[PrescribedDisplacement(top, (0.0, 0.0))],
-            obstacle_schedule=self.schedule, mu=self.mu,
-            tangential_r_max=self.tangential_r_max,
+            obstacle_schedule=self.schedule,
+            friction=FrictionSettings(self.mu, self.tangential_r_max),
         )

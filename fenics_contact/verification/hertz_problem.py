@@ -18,7 +18,11 @@ from fenics_contact.model.candidates import CandidateMode, choose_candidates
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import LinearElastic
 from fenics_contact.model.obstacles import RigidPlane
-from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
+from fenics_contact.model.problem import (
+    ContactProblem,
+    PrescribedDisplacement,
+    one_body_problem,
+)
 from fenics_contact.scene.meshing import CONTACT_TAG, TOP_TAG, hertz_half_disk
 from fenics_contact.verification.hertz import (
     ContactProfileFit,
@@ -115,7 +119,7 @@ class HertzCylinder:
         top = tags.find(TOP_TAG)
         plane = RigidPlane(domain, point=(0.0, 0.0), normal=(0.0, 1.0))
         candidates = choose_candidates(domain, plane, band, self.candidates, self.push)
-        return ContactProblem(
+        return one_body_problem(
             domain,
             self.material(),
             plane,

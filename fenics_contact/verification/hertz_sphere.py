@@ -19,7 +19,11 @@ from mpi4py import MPI
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import Elastic, material
 from fenics_contact.model.obstacles import RigidPlane
-from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
+from fenics_contact.model.problem import (
+    ContactProblem,
+    PrescribedDisplacement,
+    one_body_problem,
+)
 from fenics_contact.scene.meshing import (
     CONTACT_TAG,
     SYMMETRY_X_TAG,
@@ -88,7 +92,7 @@ class HertzSphere:
             PrescribedDisplacement(tags.find(SYMMETRY_X_TAG), (0.0, None, None)),
             PrescribedDisplacement(tags.find(SYMMETRY_Y_TAG), (None, 0.0, None)),
         ]
-        return ContactProblem(
+        return one_body_problem(
             domain, self.material(), plane, candidates, settings, prescribed=prescribed
         )
 

@@ -21,7 +21,11 @@ from mpi4py import MPI
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import Elastic, material
 from fenics_contact.model.obstacles import RigidBall
-from fenics_contact.model.problem import ContactProblem, PrescribedDisplacement
+from fenics_contact.model.problem import (
+    ContactProblem,
+    PrescribedDisplacement,
+    one_body_problem,
+)
 
 
 def cells_for_dofs(dofs: float) -> int:
@@ -84,7 +88,7 @@ class BlockIndentation:
             PrescribedDisplacement(plane(0, 0.0), (0.0, None, None)),
             PrescribedDisplacement(plane(1, 0.0), (None, 0.0, None)),
         ]
-        return ContactProblem(
+        return one_body_problem(
             domain, self.material(), ball, contact, settings, prescribed=prescribed,
             obstacle_motion=(0.0, 0.0, -self.depth),
         )

@@ -43,13 +43,16 @@ from fenics_contact.model.contact import (
     assemble_local,
     augmented_lagrangian_energy,
     augmented_pressure,
+    check_r,
     penalty_energy,
 )
 from fenics_contact.model.materials import Elastic
 from fenics_contact.model.problem import (
+    Body,
     ContactState,
     PrescribedDisplacement,
-    ProblemBase,
+    ProblemState,
+    Solid,
     VariationalSystem,
 )
 
@@ -119,7 +122,7 @@ def _oriented_vertices(domain: mesh.Mesh, facet: np.ndarray) -> tuple[np.ndarray
     return next(v for v in domain.comm.allgather(found) if v is not None)
 
 
-class StrikerOnFacetProblem(ProblemBase):
+class StrikerOnFacetProblem:
     """One deformable body, one prescribed striker node, one target facet.
 
     Exposes the system methods of :class:`fenics_contact.model.problem.ContactProblem`
@@ -141,6 +144,10 @@ class StrikerOnFacetProblem(ProblemBase):
             (2 on quadrilaterals: 2 x 2 Gauss, the full integration of the
             paper's code).
     """
+
+    #: No friction; lam is the striker's force.
+    frictional = False
+    multiplier_is_pressure = True
 
     def __init__(
         self,
@@ -176,8 +183,11 @@ class StrikerOnFacetProblem(ProblemBase):
         self._start = np.asarray(striker_start, float)
         self._motion = np.asarray(striker_motion, float)
 
-        self.V = fem.functionspace(domain, ("Lagrange", 1, (2,)))
-        self.u = fem.Function(self.V, name="displacement")
+        self.solid = Solid(domain, [Body("body", None, material)], prescribed=prescribed,
+                           quadrature_degree=energy_quadrature_degree)
+        self.V = self.solid.V
+        self.u = self.solid.u
+        self.bcs = self.solid.bcs
         tags = mesh.meshtags(domain, fdim, facet, np.full(facet.size, CONTACT_TAG, np.int32))
         submesh, entity_map, _, _ = mesh.create_submesh(domain, fdim, facet)
         Q = fem.functionspace(submesh, ("DG", 0))
@@ -192,7 +202,6 @@ class StrikerOnFacetProblem(ProblemBase):
         self.set_r(settings.r, relative=settings.relative)
         self.load_factor = 0.0
         self.striker = fem.Constant(domain, self._start.copy())
-        self.bcs = self._dirichlet(prescribed)
 
         # the gap at the striker, from u on the target facet
         X = ufl.SpatialCoordinate(domain)
@@ -206,11 +215,7 @@ class StrikerOnFacetProblem(ProblemBase):
         self.pressure = augmented_pressure(self.gap, self.lam, self.r)
         self._inv_length = fem.Constant(domain, default_scalar_type(1.0 / length))
 
-        psi = material.strain_energy(self.u)
-        dx = ufl.Measure(
-            "dx", domain=domain, metadata={"quadrature_degree": energy_quadrature_degree}
-        )
-        self.potential = psi * dx
+        self.potential = self.solid.strain_energy()
 
         mu = ufl.TestFunction(Q)
         self._mu = mu
@@ -237,7 +242,50 @@ class StrikerOnFacetProblem(ProblemBase):
         """Move the striker to start + t motion and scale the prescribed values."""
         self.load_factor = float(t)
         self.striker.value[:] = self._start + t * self._motion
-        self._apply_prescribed(t)
+        self.solid.set_load(t)
+
+    def set_r(self, r: float, *, relative: bool) -> None:
+        """Set r, relative to E/L or absolute (stress per length)."""
+        check_r(r)
+        self.r.value = r * self.stiffness_scale if relative else r
+
+    @property
+    def r_absolute(self) -> float:
+        """R in stress per length."""
+        return float(self.r.value)
+
+    @property
+    def r_relative(self) -> float:
+        """R divided by E/L."""
+        return self.r_absolute / self.stiffness_scale
+
+    def commit(self) -> None:
+        """Accept the converged state (nothing history-dependent here)."""
+
+    def multipliers(self) -> list[fem.Function]:
+        """The striker's contact force."""
+        return [self.lam]
+
+    normal_multipliers = multipliers
+
+    def snapshot(self) -> ProblemState:
+        """Copy u, lam and the load factor."""
+        return ProblemState(self.u.x.array.copy(), (self.lam.x.array.copy(),), self.load_factor)
+
+    def restore(self, state: ProblemState, *, load: bool = True) -> None:
+        """Put back a :meth:`snapshot`; ``load=False`` keeps the current load factor."""
+        self.u.x.array[:] = state.u
+        self.lam.x.array[:] = state.multipliers[0]
+        if load:
+            self.set_load(state.load_factor)
+
+    def prescribed_mismatch(self) -> float:
+        """Largest |u - u_D| over the prescribed components (length, global)."""
+        return self.solid.prescribed_mismatch()
+
+    def min_det_F(self):
+        """Smallest det F over the body."""
+        return self.solid.min_det_F()
 
     # -- systems handed to solvers -------------------------------------------
     def _lagrangian(self) -> ufl.Form:

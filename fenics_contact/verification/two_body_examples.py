@@ -16,10 +16,15 @@ from dolfinx.io.gmsh import MeshData
 from mpi4py import MPI
 
 from fenics_contact.model.contact import ContactSettings
+from fenics_contact.model.friction import FrictionSettings
 from fenics_contact.model.materials import material
-from fenics_contact.model.pair_friction import FrictionalTwoBodyProblem
-from fenics_contact.model.pairs import Body, TwoBodyProblem
-from fenics_contact.model.problem import PathDisplacement, PrescribedDisplacement
+from fenics_contact.model.problem import (
+    Body,
+    ContactProblem,
+    PathDisplacement,
+    PrescribedDisplacement,
+    two_body_problem,
+)
 from fenics_contact.scene import two_body_meshing as tbm
 
 #: Prescribed components by facet tag (None: free), values at load factor 1 (length).
@@ -38,7 +43,7 @@ def linear_pair(
     paths: dict[int, Path] | None = None,
     mu: float | None = None,
     tangential_r_max: float | None = 2.0,
-) -> TwoBodyProblem:
+) -> ContactProblem:
     """Linear elastic bodies (nu = 0.3) on a :mod:`~fenics_contact.scene.two_body_meshing` mesh.
 
     The upper body (cell tag STRIKER_TAG) is the striker, its contact face
@@ -51,8 +56,8 @@ def linear_pair(
         E_upper: Young's modulus of the striker (stress).
         E_lower: Young's modulus of the target (stress).
         paths: displacements by facet tag along a piecewise-linear path in the load factor.
-        mu: Coulomb coefficient (None: frictionless :class:`TwoBodyProblem`;
-            a number, 0 included: :class:`FrictionalTwoBodyProblem`).
+        mu: Coulomb coefficient (None: frictionless; a number, 0 included: Coulomb
+            friction).
         tangential_r_max: cap of r_t relative to E/L (friction only; None: r_t = r).
     """
     ft = md.facet_tags
@@ -63,10 +68,8 @@ def linear_pair(
                    for tag, path in (paths or {}).items()]
     args = (md.mesh, md.cell_tags, bodies, ft.find(tbm.STRIKER_FACE_TAG),
             ft.find(tbm.TARGET_FACE_TAG), settings)
-    if mu is None:
-        return TwoBodyProblem(*args, prescribed=prescribed)
-    return FrictionalTwoBodyProblem(*args, mu=mu, tangential_r_max=tangential_r_max,
-                                    prescribed=prescribed)
+    friction = None if mu is None else FrictionSettings(mu, tangential_r_max)
+    return two_body_problem(*args, prescribed=prescribed, friction=friction)
 
 
 def hemispheres_fixed(push: float) -> Fixed:
@@ -91,7 +94,7 @@ class TwoCylinders:
     steps: int = 3
     stiffness_ratio: float = 1.0
 
-    def build(self, settings: ContactSettings, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyProblem:
+    def build(self, settings: ContactSettings, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProblem:
         """Mesh both bodies and create the problem."""
         md = tbm.two_half_disks(comm, h_contact=self.h_contact, h_far=0.2)
         return linear_pair(
@@ -115,11 +118,11 @@ class BlockOnBlock:
     steps: int = 2
     upper_width: float | None = None
 
-    def build(self, settings: ContactSettings, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyProblem:
+    def build(self, settings: ContactSettings, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProblem:
         """Mesh both blocks and create the problem."""
         return self.problem(self.mesh(comm), settings)
 
-    def problem(self, md: MeshData, settings: ContactSettings) -> TwoBodyProblem:
+    def problem(self, md: MeshData, settings: ContactSettings) -> ContactProblem:
         """The problem on the mesh ``md`` of :meth:`mesh` (keep ``md`` for its facet tags)."""
         return linear_pair(md, settings, self.FIXED)
 
@@ -157,7 +160,7 @@ class SlidingBlocks(BlockOnBlock):
     path: Path = PRESS_SLIDE_PAIR
     tangential_r_max: float | None = 2.0
 
-    def problem(self, md: MeshData, settings: ContactSettings) -> TwoBodyProblem:
+    def problem(self, md: MeshData, settings: ContactSettings) -> ContactProblem:
         """The (frictional) problem on the mesh ``md`` of :meth:`mesh`."""
         return linear_pair(
             md, settings, {tbm.SUPPORT_TAG: (0.0, 0.0)},
@@ -177,7 +180,7 @@ class IroningShort:
     steps: int = 10
     slide: float = 0.6
 
-    def build(self, settings: ContactSettings, comm: MPI.Comm = MPI.COMM_WORLD) -> TwoBodyProblem:
+    def build(self, settings: ContactSettings, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProblem:
         """Mesh indenter and block and create the problem."""
         from fenics_contact.model.problem import PathDisplacement
 
@@ -186,7 +189,7 @@ class IroningShort:
         bodies = [Body("indenter", tbm.STRIKER_TAG, material("neo-hookean", 1000.0, 0.3)),
                   Body("block", tbm.TARGET_TAG, material("neo-hookean", 100.0, 0.3))]
         path = ((0.0, 0.0, 0.0), (0.2, 0.0, -0.1), (1.0, self.slide, -0.1))
-        return TwoBodyProblem(
+        return two_body_problem(
             md.mesh, md.cell_tags, bodies, ft.find(tbm.STRIKER_FACE_TAG),
             ft.find(tbm.TARGET_FACE_TAG), settings,
             prescribed=[PrescribedDisplacement(ft.find(tbm.SUPPORT_TAG), (0.0, 0.0)),

@@ -1,0 +1,367 @@
+"""The deformable part of a problem: bodies in one mesh, their laws and conditions.
+
+A :class:`Solid` owns the displacement ``u`` (vector P-k on the mesh), the
+strain energy of every body (each body a set of cells with its own law),
+the Dirichlet conditions and the surface tractions. All loads are
+proportional to one load factor ``t`` in [0, 1]. Contacts
+(:mod:`.obstacle_contact`, :mod:`.pairs`) are added to it by
+:class:`~fenics_contact.model.problem.ContactProblem`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import ufl
+import ufl.algorithms
+from dolfinx import default_scalar_type, fem, la, mesh
+
+from mpi4py import MPI
+
+from fenics_contact.model.materials import Elastic
+
+
+@dataclass(frozen=True)
+class Body:
+    """One body of the mesh.
+
+    Attributes:
+        name: label used in outputs.
+        tag: its cell tag in the mesh (None: every cell, a one-body mesh).
+        material: its constitutive law.
+    """
+
+    name: str
+    tag: int | None
+    material: Elastic
+
+
+@dataclass(frozen=True)
+class PrescribedDisplacement:
+    """Displacement imposed on facets, proportional to the load factor.
+
+    Attributes:
+        facets: facet indices (local) where the condition holds.
+        value: final displacement per component (length units); ``None``
+            leaves that component free.
+    """
+
+    facets: np.ndarray
+    value: tuple[float | None, ...]
+
+    def at(self, t: float) -> tuple[float | None, ...]:
+        """Displacement per component at load factor t (None: free)."""
+        return tuple(None if v is None else t * float(v) for v in self.value)
+
+
+@dataclass(frozen=True)
+class PathDisplacement(PrescribedDisplacement):
+    """A prescribed displacement along a piecewise-linear path in the load factor.
+
+    Attributes:
+        path: knots (t, u_1, ..., u_d), t increasing from 0 to 1 (length units);
+            every component is prescribed and ``value`` (the end point) is unused.
+    """
+
+    path: tuple[tuple[float, ...], ...] = ()
+
+    def at(self, t: float) -> tuple[float | None, ...]:
+        """Displacement at load factor t (linear between knots)."""
+        knots = np.asarray(self.path, float)
+        return tuple(float(np.interp(t, knots[:, 0], knots[:, 1 + i]))
+                     for i in range(knots.shape[1] - 1))
+
+
+@dataclass(frozen=True)
+class SurfaceTraction:
+    """Traction on facets per unit reference area, proportional to the load factor."""
+
+    facets: np.ndarray
+    value: tuple[float, ...]
+
+
+@dataclass(frozen=True)
+class DetFMinimum:
+    """Smallest det F = det(I + grad u) over the body's quadrature points.
+
+    Attributes:
+        value: the global minimum (1 undeformed, <= 0 inverted).
+        where: reference coordinates of the midpoint of the cell holding it
+            (length; 3 entries, z = 0 in 2D).
+    """
+
+    value: float
+    where: tuple[float, float, float]
+
+
+def energy_quadrature_degree(psi: ufl.core.expr.Expr, u: fem.Function, degree: int) -> int:
+    """Quadrature degree for the strain energy and its derivatives.
+
+    UFL's estimate for the tangent, capped at 2 (degree + 1): exact for
+    linear elasticity and St. Venant-Kirchhoff on simplices and for linear
+    elasticity on quadrilaterals/hexahedra, and it keeps non-polynomial
+    laws (neo-Hookean: estimate 17 on hexahedra) affordable.
+    """
+    v = ufl.TestFunction(u.function_space)
+    tangent = ufl.derivative(ufl.derivative(psi * ufl.dx, u, v), u)
+    integrand = ufl.algorithms.expand_derivatives(tangent).integrals()[0].integrand()
+    estimate = ufl.algorithms.estimate_total_polynomial_degree(integrand)
+    return int(min(estimate, 2 * (degree + 1)))
+
+
+def _check_bodies(domain: mesh.Mesh, cell_tags: mesh.MeshTags | None,
+                  bodies: Sequence[Body]) -> None:
+    """Raise ValueError for no body, repeated tags or a tag no cell carries."""
+    if not bodies:
+        raise ValueError("Give at least one body.")
+    if cell_tags is None:
+        if len(bodies) != 1:
+            raise ValueError(
+                f"{len(bodies)} bodies need cell tags to tell them apart; give the mesh's "
+                "cell tags."
+            )
+        return
+    tags = [b.tag for b in bodies]
+    if len(set(tags)) != len(tags):
+        raise ValueError(f"Body cell tags {tags} repeat; give each body its own tag.")
+    present = set(np.unique(cell_tags.values).tolist())
+    present = set().union(*domain.comm.allgather(present))
+    for b in bodies:
+        if b.tag not in present:
+            raise ValueError(
+                f"Body {b.name!r} has cell tag {b.tag}, which no cell of the mesh carries "
+                f"(tags present: {sorted(present)})."
+            )
+
+
+class Solid:
+    """The bodies of one mesh: displacement, strain energy, Dirichlet conditions, tractions.
+
+    Args:
+        domain: the mesh (topological and geometric dimensions equal).
+        bodies: the bodies; one body with ``tag=None`` holds every cell.
+        cell_tags: the cell tags that tell several bodies apart.
+        prescribed: Dirichlet conditions (proportional or along a path).
+        tractions: surface tractions (proportional).
+        degree: polynomial degree of the displacement.
+        quadrature_degree: quadrature degree of the strain energy (default:
+            :func:`energy_quadrature_degree` of each body's law).
+    """
+
+    def __init__(
+        self,
+        domain: mesh.Mesh,
+        bodies: Sequence[Body],
+        cell_tags: mesh.MeshTags | None = None,
+        *,
+        prescribed: Sequence[PrescribedDisplacement] = (),
+        tractions: Sequence[SurfaceTraction] = (),
+        degree: int = 1,
+        quadrature_degree: int | None = None,
+    ) -> None:
+        gdim = domain.geometry.dim
+        if domain.topology.dim != gdim:
+            raise ValueError(
+                f"The body mesh is {domain.topology.dim}D in {gdim}D space; "
+                "use a mesh whose topological and geometric dimensions agree."
+            )
+        _check_bodies(domain, cell_tags, bodies)
+        for traction in tractions:
+            if len(traction.value) != gdim:
+                raise ValueError(f"Traction {traction.value} needs {gdim} components.")
+        self.domain = domain
+        self.comm = domain.comm
+        self.gdim = gdim
+        self.degree = degree
+        self.bodies = list(bodies)
+        self.cell_tags = cell_tags
+        self.tractions = list(tractions)
+        self.V = fem.functionspace(domain, ("Lagrange", degree, (gdim,)))
+        self.u = fem.Function(self.V, name="displacement")
+        self.prescribed = list(prescribed)
+        self.bcs = self._dirichlet(self.prescribed)
+        self._traction_constants = [
+            (fem.Constant(domain, np.zeros(gdim)), np.asarray(t.value, float))
+            for t in self.tractions
+        ]
+        dx = ufl.Measure("dx", domain=domain, subdomain_data=cell_tags)
+        self._dx = {}
+        for b in self.bodies:
+            psi = b.material.strain_energy(self.u)
+            q = quadrature_degree or energy_quadrature_degree(psi, self.u, degree)
+            metadata = {"quadrature_degree": q}
+            self._dx[b.tag] = dx(metadata=metadata) if b.tag is None else dx(
+                b.tag, metadata=metadata
+            )
+        self._internal_form: fem.Form | None = None
+
+    # -- energy -------------------------------------------------------------------
+    def strain_energy(self) -> ufl.Form:
+        """Sum over the bodies of int psi_b dV (energy; per unit thickness in 2D)."""
+        terms = [b.material.strain_energy(self.u) * self._dx[b.tag] for b in self.bodies]
+        return sum(terms[1:], terms[0])
+
+    def external_work(self, ds: ufl.Measure, ids: Sequence[tuple[int, ...]]) -> ufl.Form | None:
+        """Work of the tractions, int t . u dA over each traction's tagged facets.
+
+        ``ds`` carries the problem's facet tags and ``ids[i]`` the tag values
+        of the i-th traction's facets (see :func:`~.tags.facet_roles`).
+        """
+        work = None
+        for (const, _), tag_ids in zip(self._traction_constants, ids, strict=True):
+            term = ufl.dot(const, self.u) * ds(tag_ids)
+            work = term if work is None else work + term
+        return work
+
+    @property
+    def stiffest(self) -> Elastic:
+        """The first body's law (the r scale of a one-body problem)."""
+        return self.bodies[0].material
+
+    def material_of(self, body: str) -> Elastic:
+        """The law of the body named ``body``."""
+        for b in self.bodies:
+            if b.name == body:
+                return b.material
+        raise ValueError(
+            f"The body {body!r} is not among the bodies {[b.name for b in self.bodies]}; "
+            "use one of those names."
+        )
+
+    def body_of_facets(self, facets: np.ndarray, role: str) -> Body:
+        """The one body whose cells carry the facets (collective)."""
+        if self.cell_tags is None:
+            return self.bodies[0]
+        domain = self.domain
+        tdim = domain.topology.dim
+        domain.topology.create_connectivity(tdim - 1, tdim)
+        f2c = domain.topology.connectivity(tdim - 1, tdim)
+        tag_of = dict(zip(self.cell_tags.indices.tolist(), self.cell_tags.values.tolist(),
+                          strict=True))
+        local = {tag_of.get(int(c)) for f in np.asarray(facets) for c in f2c.links(int(f))}
+        tags = set().union(*self.comm.allgather(local)) - {None}
+        matching = [b for b in self.bodies if b.tag in tags]
+        if len(matching) != 1:
+            raise ValueError(
+                f"The {role} facets border cells of {len(matching)} bodies "
+                f"({[b.name for b in matching]}); a {role} surface lies on one body."
+            )
+        return matching[0]
+
+    # -- loads ----------------------------------------------------------------------
+    def _dirichlet(self, prescribed: Sequence[PrescribedDisplacement]) -> list[fem.DirichletBC]:
+        """One Dirichlet condition per prescribed component, valued by :meth:`set_load`."""
+        fdim = self.domain.topology.dim - 1
+        self._bc_constants: list[tuple[fem.Constant, PrescribedDisplacement, int]] = []
+        bcs = []
+        for condition in prescribed:
+            components = condition.at(1.0)
+            if len(components) != self.gdim:
+                raise ValueError(
+                    f"Prescribed displacement {condition.value} needs one entry per "
+                    f"component ({self.gdim}); use None for a free one."
+                )
+            for i, value in enumerate(components):
+                if value is None:
+                    continue
+                Vi = self.V.sub(i)
+                dofs = fem.locate_dofs_topological(Vi, fdim, condition.facets)
+                const = fem.Constant(self.domain, default_scalar_type(0.0))
+                self._bc_constants.append((const, condition, i))
+                bcs.append(fem.dirichletbc(const, dofs, Vi))
+        return bcs
+
+    def set_load(self, t: float) -> None:
+        """Set every prescribed component and traction to its value at load factor t."""
+        for const, condition, i in self._bc_constants:
+            const.value = condition.at(t)[i]
+        for const, value in self._traction_constants:
+            const.value[:] = t * value
+
+    def prescribed_mismatch(self) -> float:
+        """Largest |u - u_D| over the prescribed components at the current load (length).
+
+        Global over ranks. Zero once a Newton step has been taken at this load
+        factor (the Dirichlet rows are linear); the increment of the
+        prescribed values before the first step of a load step.
+        """
+        local = 0.0
+        for (const, _, _), bc in zip(self._bc_constants, self.bcs, strict=True):
+            dofs, n_owned = bc.dof_indices()
+            values = self.u.x.array[dofs[:n_owned]]
+            local = max(local, float(np.max(np.abs(values - float(const.value)), initial=0.0)))
+        return self.comm.allreduce(local, op=MPI.MAX)
+
+    # -- diagnostics --------------------------------------------------------------------
+    def reaction(self, facets: np.ndarray) -> np.ndarray:
+        """Internal nodal force summed over the facets' nodes, per component (force).
+
+        With prescribed displacements on those facets this is the force the
+        support exerts on the body (per unit thickness in 2D); tractions on
+        the same facets are not included.
+        """
+        if self._internal_form is None:
+            v = ufl.TestFunction(self.V)
+            self._internal_form = fem.form(ufl.derivative(self.strain_energy(), self.u, v))
+        vec = fem.assemble_vector(self._internal_form)
+        vec.scatter_reverse(la.InsertMode.add)
+        n_owned = self.V.dofmap.index_map.size_local
+        out = np.zeros(self.gdim)
+        for i in range(self.gdim):
+            dofs = fem.locate_dofs_topological(self.V.sub(i), self.gdim - 1, facets)
+            dofs = dofs[dofs < n_owned * self.gdim]
+            out[i] = vec.array[dofs].sum()
+        return self.comm.allreduce(out, op=MPI.SUM)
+
+    def laws(self) -> list[tuple[Elastic, np.ndarray | None]]:
+        """Each body's law and its cells (None: every cell)."""
+        return [
+            (b.material, None if b.tag is None else self.cell_tags.find(b.tag))
+            for b in self.bodies
+        ]
+
+    def body_ids(self) -> fem.Function | None:
+        """Cell-wise body index (0, 1, ...) in the order of ``bodies`` (DG0); None for one body."""
+        if len(self.bodies) == 1:
+            return None
+        D = fem.functionspace(self.domain, ("DG", 0))
+        f = fem.Function(D, name="body_id")
+        for i, b in enumerate(self.bodies):
+            cells = self.cell_tags.find(b.tag)
+            f.x.array[D.dofmap.list[cells].reshape(-1)] = float(i)
+        f.x.scatter_forward()
+        return f
+
+    def min_det_F(self) -> DetFMinimum:
+        """Smallest det F over the bodies (quadrature points of degree 2, all ranks).
+
+        The points are those of a degree-2 rule on the cell, where the strain
+        energy is integrated; one compiled expression per solid.
+        """
+        if not hasattr(self, "_det_expr"):
+            import basix
+
+            points, _ = basix.make_quadrature(self.domain.basix_cell(), 2)
+            F = ufl.Identity(self.gdim) + ufl.grad(self.u)
+            self._det_expr = fem.Expression(ufl.det(F), points)
+            self._det_cells = np.arange(
+                self.domain.topology.index_map(self.domain.topology.dim).size_local,
+                dtype=np.int32,
+            )
+        if self._det_cells.size:
+            values = self._det_expr.eval(self.domain, self._det_cells)
+            per_cell = values.reshape(self._det_cells.size, -1).min(axis=1)
+            worst = int(np.argmin(per_cell))
+            local = float(per_cell[worst])
+            where = mesh.compute_midpoints(
+                self.domain, self.domain.topology.dim, self._det_cells[worst : worst + 1]
+            )[0]
+        else:  # a rank without cells
+            local, where = np.inf, np.zeros(3)
+        if not np.isfinite(local):
+            local = -np.inf if np.isnan(local) else local
+        value, rank = self.comm.allreduce((local, self.comm.rank), op=MPI.MINLOC)
+        where = self.comm.bcast(np.asarray(where, float), root=rank)
+        return DetFMinimum(float(value), (float(where[0]), float(where[1]), float(where[2])))

@@ -1,0 +1,238 @@
+"""One contact of a problem: a candidate surface, its multiplier and its partner.
+
+A :class:`Contact` is described first (its facets, its settings, optional
+friction) and bound to a :class:`~.body.Solid` by the problem, which hands it
+the problem's facet tags. Bound, it holds the contact submesh with the
+multiplier ``lam`` (P1, <= 0 the pressure), its own parameter ``r`` and the
+gap ``g`` to its partner as a UFL expression; a subclass says what the
+partner is (:class:`~.obstacle_contact.ObstacleContact`, a rigid obstacle;
+:class:`~.pairs.NodeToSegmentContact`, another deformable surface). Sign
+conventions as in :mod:`.contact`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import ufl
+from dolfinx import default_scalar_type, fem, mesh
+
+from mpi4py import MPI
+
+from fenics_contact.model.contact import (
+    ContactSettings,
+    ContactSurface,
+    augmented_lagrangian_energy,
+    augmented_pressure,
+    check_r,
+    penalty_energy,
+)
+from fenics_contact.model.friction import FrictionSettings
+from fenics_contact.model.friction_terms import CoulombFriction
+from fenics_contact.model.state import ContactState
+
+
+class Contact:
+    """A candidate contact surface of the solid against a partner, with optional friction.
+
+    Args:
+        facets: local facet indices of the candidate (striker) surface.
+        settings: r, its scale and the quadrature.
+        friction: Coulomb friction on this contact (None: frictionless).
+        name: label in outputs.
+
+    A subclass defines :meth:`_bind_partner` (the gap and the modulus of the
+    r scale) and, for friction, :meth:`slip_increment`.
+    """
+
+    #: Whether lam is the contact pressure of the solution (the penalty method
+    #: sets False through the problem): chooses the contact-force formula.
+    multiplier_is_pressure = True
+
+    def __init__(
+        self,
+        facets: np.ndarray,
+        settings: ContactSettings,
+        *,
+        friction: FrictionSettings | None = None,
+        name: str = "contact",
+    ) -> None:
+        self.facets = np.unique(np.asarray(facets, dtype=np.int32))
+        self.settings = settings
+        self.friction_settings = friction
+        self.friction: CoulombFriction | None = None
+        self.name = name
+
+    @property
+    def frictional(self) -> bool:
+        """Whether the contact carries Coulomb friction."""
+        return self.friction_settings is not None
+
+    # -- binding ------------------------------------------------------------------
+    def bind(self, solid, tags: mesh.MeshTags, ids: tuple[int, ...]) -> None:
+        """Build the surface, lam, r and the gap on ``solid`` (the problem calls this).
+
+        Args:
+            solid: the :class:`~.body.Solid` the surface belongs to.
+            tags: the problem's facet tags.
+            ids: the tag values of this contact's facets in ``tags``.
+        """
+        self.solid = solid
+        self.domain = solid.domain
+        self.comm = solid.comm
+        self.gdim = solid.gdim
+        self.surface = ContactSurface(
+            self.domain, self.facets, self.settings.quadrature, tags=tags, ids=ids
+        )
+        self.Q = self.surface.Q
+        self.lam = fem.Function(self.Q, name="contact_pressure")
+        self.r = fem.Constant(self.domain, default_scalar_type(1.0))
+        self.gap = self._bind_partner(solid)
+        self.set_r(self.settings.r, relative=self.settings.relative)
+        self.pressure = augmented_pressure(self.gap, self.lam, self.r)
+        self._gap_form = self.surface.nodal_form(self.gap)
+        self._pressure_form = self.surface.nodal_form(self.pressure)
+        self._force_form = fem.form(
+            -self.pressure * self.surface.ds, entity_maps=self.surface.entity_maps
+        )
+        self._multiplier_force_form = fem.form(
+            -self.lam * self.surface.ds, entity_maps=self.surface.entity_maps
+        )
+
+    def bind_friction(self, u_prev: fem.Function) -> None:
+        """Add the Coulomb terms (after :meth:`bind`; u_prev: the last converged u)."""
+        if self.friction_settings is not None:
+            self.friction = CoulombFriction(self, self.friction_settings, u_prev)
+
+    def _bind_partner(self, solid) -> ufl.core.expr.Expr:
+        """Set up the partner; return the gap g(u) (length, >= 0 open)."""
+        raise NotImplementedError
+
+    #: E of the r scale (stress); set by :meth:`_bind_partner`.
+    modulus: float
+
+    # -- parameters and loads ----------------------------------------------------------
+    @property
+    def stiffness_scale(self) -> float:
+        """E/h: the scale that makes r dimensionless (stress per length)."""
+        return self.modulus / self.surface.h
+
+    def set_r(self, r: float, *, relative: bool) -> None:
+        """Set the penalty/augmentation parameter, relative to E/h or absolute."""
+        check_r(r)
+        self.r.value = r * self.stiffness_scale if relative else r
+
+    def set_load(self, t: float) -> None:
+        """Move the partner to load factor t (a moving obstacle); nothing by default."""
+
+    def refresh(self) -> bool:
+        """Bring data that follow u up to date (a search); True when an assignment changed."""
+        return False
+
+    def commit_frame(self) -> None:
+        """Move the reference of the slip forward after a converged increment."""
+
+    def extras(self) -> list[fem.Function]:
+        """Coefficients that are a selection of u (a deformable target's displacements)."""
+        return []
+
+    @property
+    def transfer(self):
+        """The search that refreshes :meth:`extras` and selects them from u (or None)."""
+        return None
+
+    def slip_increment(self, u_prev: fem.Function) -> tuple[ufl.core.expr.Expr, ufl.core.expr.Expr]:
+        """(T, dg_t): the gdim x (d-1) tangent matrix and the slip increment (length)."""
+        raise NotImplementedError
+
+    def penetration(self) -> float | None:
+        """Global depth inside the partner's actual surface when it differs from -min(g, 0)."""
+        return None
+
+    # -- UFL terms ------------------------------------------------------------------------
+    def lagrangian(self) -> ufl.Form:
+        """Int [min(lam + r g, 0)^2 - lam^2] / (2 r) ds (paper eq. 9)."""
+        return augmented_lagrangian_energy(self.gap, self.lam, self.r) * self.surface.ds
+
+    def penalty(self) -> ufl.Form:
+        """Int r/2 min(g, 0)^2 ds (paper eq. 7)."""
+        return penalty_energy(self.gap, self.r) * self.surface.ds
+
+    def complementarity_residual(self) -> ufl.Form:
+        """(min(lam + r g, 0) - lam) mu: zero when lam is the converged pressure."""
+        mu = ufl.TestFunction(self.Q)
+        return (self.pressure - self.lam) * mu * self.surface.ds
+
+    # -- nodal values and diagnostics --------------------------------------------------------
+    def nodal_pressure(self, lam: np.ndarray) -> np.ndarray:
+        """Owned nodal contact pressure (<= 0, stress) of the current iterate.
+
+        Multiplier strategies: the multiplier, min(lam, 0), with values
+        below 1e-12 of the largest pressure set to zero (the round-off of a
+        linear solve at open nodes). The transmitted min(lam + r g, 0) would
+        carry the round-off r * eps * g of the gap, of the order of the
+        pressure itself at r = 1e12 E/h. The penalty method, whose multiplier
+        is zero, transmits r min(g, 0).
+        """
+        if not self.multiplier_is_pressure:
+            return self.surface.nodal(self._pressure_form)
+        pressure = np.minimum(lam, 0.0)
+        peak = self.comm.allreduce(float(np.max(-pressure, initial=0.0)), op=MPI.MAX)
+        pressure[pressure > -1e-12 * peak] = 0.0
+        return pressure
+
+    def contact_state(self) -> ContactState:
+        """Nodal gaps, pressures, the active set and global summaries (fresh search).
+
+        With a multiplier method the pressure is the multiplier (see
+        :meth:`nodal_pressure`), so the written field, the active set and the
+        force agree at every r. Where the partner's surface is not the
+        discretisation's gap (two bodies) ``max_penetration`` is the depth
+        inside the actual surface and ``constraint_penetration`` the former.
+        """
+        self.refresh()
+        gap = self.surface.nodal(self._gap_form)
+        lam = self.lam.x.array[: gap.size].copy()
+        force_form = (self._multiplier_force_form if self.multiplier_is_pressure
+                      else self._force_form)
+        state = ContactState.gathered(
+            self.comm, gap, self.nodal_pressure(lam), lam, fem.assemble_scalar(force_form)
+        )
+        depth = self.penetration()
+        if depth is not None:
+            state = ContactState(**{**_fields(state), "max_penetration": depth,
+                                    "constraint_penetration": state.max_penetration})
+        if self.friction is not None:
+            return self.friction.with_friction(state)
+        return state
+
+    def active_pattern(self) -> bytes:
+        """This rank's active set (lam + r g < 0; with friction open/stick/slip) as bytes."""
+        self.refresh()
+        if self.friction is not None:
+            return self.friction.node_states().tobytes()
+        return np.packbits(self.surface.nodal(self._pressure_form) < 0.0).tobytes()
+
+    def update_multiplier(self) -> None:
+        """Uzawa update lam <- min(lam + r g, 0) at the nodes (paper eq. 10); friction too.
+
+        Both multipliers are evaluated at the same iterate.
+        """
+        self.refresh()
+        tau = None if self.friction is None else self.friction.nodal_traction()
+        pressure = self.surface.nodal(self._pressure_form)
+        self.lam.x.array[: pressure.size] = pressure
+        self.lam.x.scatter_forward()
+        if tau is not None:
+            self.friction.set_lam_t(tau)
+
+    def nodal_coordinates(self) -> np.ndarray:
+        """Reference coordinates of the owned multiplier nodes, shape (n, 3)."""
+        n = self.Q.dofmap.index_map.size_local
+        return self.Q.tabulate_dof_coordinates()[:n]
+
+
+def _fields(state: ContactState) -> dict:
+    return {f: getattr(state, f) for f in ContactState.__dataclass_fields__}
+
+
+__all__ = ["Contact"]

@@ -1,0 +1,292 @@
+"""The Coulomb terms of one contact: tangential multiplier, projected traction, checks.
+
+The formulas and sign conventions are those of :mod:`.friction`. A
+:class:`CoulombFriction` is built by its contact once the contact is bound
+(surface, lam, r, gap and pressure exist); the contact supplies the tangent
+frame and the slip increment (:meth:`~.contacts.Contact.slip_increment`)
+and the problem the last converged displacement ``u_prev``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import ufl
+from dolfinx import default_scalar_type, fem
+
+from mpi4py import MPI
+
+from fenics_contact.model.contact import assemble_local
+from fenics_contact.model.friction import (
+    GUARD,
+    OPEN,
+    SLIP,
+    STICK,
+    FrictionalContactState,
+    FrictionSettings,
+    coulomb_projection,
+    surface_extent,
+    symmetry_planes,
+)
+from fenics_contact.model.state import ContactState
+
+
+class CoulombFriction:
+    """Coulomb friction on one contact (rigid obstacle or deformable target).
+
+    Holds the tangential multiplier lam_t (P1 on the contact submesh, d-1
+    components), the projected traction tau = P(lam_t + r_t dg_t), the
+    regularised-stick traction of the penalty method, the residual terms and
+    the nodal diagnostics.
+
+    Args:
+        contact: the bound contact (see :class:`~.contacts.Contact`).
+        settings: mu and the cap of r_t.
+        u_prev: the last converged displacement, shared by the problem.
+    """
+
+    def __init__(self, contact, settings: FrictionSettings, u_prev: fem.Function) -> None:
+        self.contact = contact
+        surface = contact.surface
+        domain = contact.domain
+        gdim = contact.gdim
+        self.gdim = gdim
+        self.comm = contact.comm
+        self.surface = surface
+        self.u_prev = u_prev
+        self.mu = fem.Constant(domain, default_scalar_type(settings.mu))
+        self.eps = fem.Constant(domain, default_scalar_type(GUARD * contact.modulus))
+        if gdim == 2:
+            self.Qt = contact.Q
+            self.lam_t = fem.Function(self.Qt, name="tangential_multiplier")
+            lam_t = ufl.as_vector([self.lam_t])
+        else:
+            self.Qt = fem.functionspace(surface.submesh, ("Lagrange", 1, (gdim - 1,)))
+            self.lam_t = fem.Function(self.Qt, name="tangential_multiplier")
+            lam_t = self.lam_t
+        self.tangents, self.slip = contact.slip_increment(u_prev)
+        #: 1 per tangential component, 0 where a symmetry plane through the contact
+        #: zone makes the traction's component across the plane vanish.
+        self.symmetry_mask = fem.Function(self.Qt, name="symmetry_mask")
+        self.symmetry_mask.x.array[:] = 1.0
+        mask = ufl.as_vector([self.symmetry_mask]) if gdim == 2 else self.symmetry_mask
+        #: Extent L of the candidate contact surface (length).
+        self.contact_extent = surface_extent(surface.submesh)
+        #: Tangential parameter r_t = min(r, r_t_cap), r_t_cap = tangential_r_max E/L
+        #: (stress/length, E the modulus of the r scale); follows r when a strategy
+        #: changes it.
+        cap = (np.inf if settings.tangential_r_max is None
+               else settings.tangential_r_max * contact.modulus / self.contact_extent)
+        self.r_t_cap = fem.Constant(domain, default_scalar_type(cap))
+        self.r_t: ufl.core.expr.Expr = ufl.min_value(contact.r, self.r_t_cap)
+        self.trial_traction = lam_t + self.r_t * self.slip
+        self.coulomb_radius = -self.mu * contact.pressure
+        self.traction_t = ufl.elem_mult(
+            mask, coulomb_projection(self.trial_traction, self.coulomb_radius, self.eps)
+        )
+        self._lam_t_vector = lam_t
+        # penalty: regularised stick on the committed traction, rho = mu r max(-g, 0)
+        self._penalty_radius = -self.mu * ufl.min_value(contact.r * contact.gap, 0.0)
+        self.penalty_traction = ufl.elem_mult(
+            mask, coulomb_projection(self.trial_traction, self._penalty_radius, self.eps)
+        )
+
+        k = gdim - 1
+        nodal = surface.nodal_form
+        self._tau_forms = [nodal(self.traction_t[i]) for i in range(k)]
+        self._pen_forms = [nodal(self.penalty_traction[i]) for i in range(k)]
+        self._slip_forms = [nodal(self.slip[i]) for i in range(k)]
+        self._y_forms = [nodal(self.trial_traction[i]) for i in range(k)]
+        self._rho_form = nodal(self.coulomb_radius)
+        self._global_forms = [
+            [nodal(-(self.tangents * self.traction_t)[i]) for i in range(gdim)],
+            [nodal((self.tangents * self.slip)[i]) for i in range(gdim)],
+        ]
+        force = self.tangents * self.traction_t
+        self._tforce_forms = [
+            fem.form(force[i] * surface.ds, entity_maps=surface.entity_maps)
+            for i in range(gdim)
+        ]
+        self._tmag_form = fem.form(
+            ufl.sqrt(ufl.dot(self.traction_t, self.traction_t)) * surface.ds,
+            entity_maps=surface.entity_maps,
+        )
+        self.symmetry_constraints = self._constrain_symmetry_planes()
+
+    def _constrain_symmetry_planes(self) -> int:
+        """Zero the traction across every symmetry plane at the contact nodes it holds.
+
+        A symmetry plane is a Dirichlet condition holding one displacement
+        component at 0 on a plane of facets normal to that axis (see
+        :func:`~.friction.symmetry_planes`). At a contact node on it the slip
+        across the plane vanishes identically, so a sticking node would leave
+        the tangential multiplier's component across the plane undetermined
+        (a singular Jacobian); by symmetry that traction component is zero,
+        and :attr:`symmetry_mask` makes it so (residual row lam_t,k = 0, no
+        force). The frame component along the plane's normal is found from
+        the nodal tangents; a frame not aligned with the plane is refused.
+        Returns the number of constrained (node, component) pairs (global).
+        """
+        domain = self.contact.domain
+        planes = symmetry_planes(domain, self.contact.solid.prescribed)
+        if not planes:
+            return 0
+        fdim = domain.topology.dim - 1
+        W = fem.functionspace(domain, ("Lagrange", 1))
+        parent = self.surface.parent_dofs(W)
+        n_owned = self.contact.Q.dofmap.index_map.size_local
+        k = self.gdim - 1
+        self.contact.refresh()
+        frame = np.stack([
+            np.column_stack([self.surface.nodal(self.surface.nodal_form(self.tangents[i, j]))
+                             for j in range(k)])
+            for i in range(self.gdim)
+        ], axis=1)  # (owned nodes, gdim, d-1)
+        count = 0
+        for facets, axis in planes:
+            held = fem.locate_dofs_topological(W, fdim, facets)
+            nodes = np.flatnonzero(np.isin(parent[:n_owned], held))
+            along = np.abs(frame[nodes, axis, :])
+            j = np.argmax(along, axis=1) if nodes.size else np.zeros(0, int)
+            worst = float(np.min(along[np.arange(nodes.size), j], initial=1.0))
+            worst = self.comm.allreduce(worst, op=MPI.MIN)
+            if worst < 1.0 - 1e-8:
+                raise ValueError(
+                    f"A symmetry plane (u_{'xyz'[axis]} = 0 on a plane normal to "
+                    f"{'xyz'[axis]}) crosses the frictional contact surface where the contact "
+                    f"normal is not in the plane (|t . e_{'xyz'[axis]}| = {worst:.3g}); a "
+                    "symmetry cut needs the contact normal in the plane there."
+                )
+            self.symmetry_mask.x.array[nodes * k + j] = 0.0
+            count += self.comm.allreduce(int(nodes.size), op=MPI.SUM)
+        self.symmetry_mask.x.scatter_forward()
+        return count
+
+    # -- the tangential parameter --------------------------------------------------------
+    @property
+    def tangential_r(self) -> float:
+        """The current tangential parameter r_t = min(r, cap) (stress per length)."""
+        return min(float(self.contact.r.value), float(self.r_t_cap.value))
+
+    @property
+    def tangential_cap(self) -> float:
+        """The cap of r_t (stress per length; inf when r_t = r)."""
+        return float(self.r_t_cap.value)
+
+    def set_tangential_cap(self, cap: float) -> None:
+        """Set the cap of r_t (absolute, stress per length; inf: r_t = r). No recompilation."""
+        if not cap > 0:
+            raise ValueError(f"The cap of r_t must be > 0 (stress per length), got {cap}.")
+        self.r_t_cap.value = cap
+
+    # -- residual terms ---------------------------------------------------------------------
+    def work(self, traction: ufl.core.expr.Expr, c: fem.Function,
+             test: ufl.Argument) -> ufl.Form:
+        """Int traction . d(dg_t)/dc[test] ds: the friction force on u or on an extra c.
+
+        The body (and, for a deformable target, the target's vertices through
+        the derivative with respect to w_k) receives the friction force.
+        """
+        return ufl.dot(traction, ufl.derivative(self.slip, c, test)) * self.surface.ds
+
+    def tangential_residual(self) -> ufl.Form:
+        """(P(lam_t + r_t dg_t) - lam_t) . mu_t ds (force units)."""
+        mu_t = ufl.TestFunction(self.Qt)
+        mu_t = ufl.as_vector([mu_t]) if self.gdim == 2 else mu_t
+        return ufl.dot(self.traction_t - self._lam_t_vector, mu_t) * self.surface.ds
+
+    # -- nodal values --------------------------------------------------------------------------
+    def _nodal_components(self, forms: Sequence[fem.Form]) -> np.ndarray:
+        """Owned nodal values of a (d-1)-vector expression, shape (n, d-1)."""
+        self.contact.refresh()
+        return np.column_stack([self.surface.nodal(f) for f in forms])
+
+    def nodal_traction(self) -> np.ndarray:
+        """Owned nodal tau = P(lam_t + r_t dg_t), shape (n, d-1) (stress)."""
+        return self._nodal_components(self._tau_forms)
+
+    def set_lam_t(self, values: np.ndarray) -> None:
+        """Set the owned nodal lam_t (shape (n, d-1)) and update the ghosts."""
+        n = values.shape[0]
+        self.lam_t.x.array[: n * (self.gdim - 1)] = values.reshape(-1)
+        self.lam_t.x.scatter_forward()
+
+    def keep_penalty_traction(self) -> None:
+        """lam_t <- the regularised-stick traction of the penalty method (its history)."""
+        self.set_lam_t(self._nodal_components(self._pen_forms))
+
+    def node_states(self) -> np.ndarray:
+        """Per owned node: 0 open (p_n = 0), 1 stick (|y| < rho), 2 slip."""
+        y = self._nodal_components(self._y_forms)
+        rho = self.surface.nodal(self._rho_form)
+        eps = float(self.eps.value)
+        norm = np.sqrt(np.sum(y**2, axis=1) + eps**2)
+        state = np.full(rho.size, OPEN, dtype=np.int8)
+        active = self.surface.nodal(self.contact._pressure_form) < 0.0
+        state[active] = np.where(norm[active] < rho[active], STICK, SLIP)
+        return state
+
+    def tangential_fields(self) -> tuple[np.ndarray, np.ndarray]:
+        """Owned nodal vectors in global axes, shape (n, gdim) each.
+
+        The tangential traction on the body -T tau (stress) and the slip
+        increment T dg_t of the body relative to the obstacle or target (length).
+        """
+        traction, slip = (self._nodal_components(forms) for forms in self._global_forms)
+        return traction, slip
+
+    def tangential_force_vector(self) -> np.ndarray:
+        """Global int T tau dA (force; per thickness in 2D): minus the friction on the body."""
+        self.contact.refresh()
+        return np.array([
+            self.comm.allreduce(fem.assemble_scalar(f), op=MPI.SUM) for f in self._tforce_forms
+        ])
+
+    def with_friction(self, base: ContactState) -> FrictionalContactState:
+        """The normal diagnostics ``base`` plus tangential traction, slip, limit and states."""
+        states = self.node_states()
+        comm = self.comm
+        normal = {f: getattr(base, f) for f in ContactState.__dataclass_fields__}
+        return FrictionalContactState(**{
+            **normal,
+            "tangential_traction": self._nodal_components(self._tau_forms),
+            "slip": self._nodal_components(self._slip_forms),
+            "coulomb_limit": self.surface.nodal(self._rho_form),
+            "node_state": states,
+            "tangential_force": float(np.linalg.norm(self.tangential_force_vector())),
+            "tangential_magnitude": comm.allreduce(
+                fem.assemble_scalar(self._tmag_form), op=MPI.SUM
+            ),
+            "stick_count": comm.allreduce(int(np.sum(states == STICK)), op=MPI.SUM),
+            "slip_count": comm.allreduce(int(np.sum(states == SLIP)), op=MPI.SUM),
+        })
+
+    def coulomb_violations(self) -> tuple[float, float, float]:
+        """Worst nodal violations of the Coulomb conditions, global over ranks.
+
+        Returns (largest |dg_t| at sticking nodes (length), largest
+        |tau - lam_t| (stress), largest |lam_t| - rho (stress)); all zero at
+        an exact nodal solution, whatever r and r_t. Only meaningful with the
+        vertex rule (the conditions hold at the nodes).
+        """
+        slip = np.linalg.norm(self._nodal_components(self._slip_forms), axis=1)
+        tau = self._nodal_components(self._tau_forms)
+        lam_t = self.lam_t.x.array[: tau.size].reshape(tau.shape)
+        rho = self.surface.nodal(self._rho_form)
+        sticks = self.node_states() == STICK
+        local = (
+            float(np.max(slip[sticks], initial=0.0)),
+            float(np.max(np.linalg.norm(tau - lam_t, axis=1), initial=0.0)),
+            float(np.max(np.linalg.norm(lam_t, axis=1) - rho, initial=0.0)),
+        )
+        return tuple(self.comm.allreduce(v, op=MPI.MAX) for v in local)
+
+    def complementarity_squares(self) -> tuple[float, float]:
+        """Global squared norms of the normal and tangential complementarity residuals."""
+        self.contact.refresh()
+        out = []
+        for form in (self.contact.complementarity_residual(), self.tangential_residual()):
+            local = assemble_local(fem.form(form, entity_maps=self.surface.entity_maps))
+            out.append(self.comm.allreduce(float(local @ local), op=MPI.SUM))
+        return out[0], out[1]

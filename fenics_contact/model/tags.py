@@ -1,0 +1,43 @@
+"""One facet tag set for every surface integral of a problem.
+
+A DOLFINx form takes one subdomain data per integral type, so every ``ds``
+of a problem (each contact surface, each traction) must read the same
+facet tags. A facet may play several roles (a traction on a candidate
+contact surface, a surface that meets two partners): each distinct
+combination of roles gets its own tag value, and role i integrates over
+the tuple of tag values whose combination holds i, ``ds(ids[i])``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from dolfinx import mesh
+
+
+def facet_roles(
+    domain: mesh.Mesh, groups: Sequence[np.ndarray]
+) -> tuple[mesh.MeshTags, list[tuple[int, ...]]]:
+    """Facet tags for role groups (local facet indices) and each group's tag values.
+
+    Tag values start at 1 and are numbered by the sorted combinations of
+    roles, the same on every rank. A group with no facet on any rank gets
+    an empty tuple.
+    """
+    fdim = domain.topology.dim - 1
+    n_facets = domain.topology.index_map(fdim).size_local + \
+        domain.topology.index_map(fdim).num_ghosts
+    bits = np.zeros(n_facets, dtype=np.int64)
+    if len(groups) > 62:
+        raise ValueError(f"{len(groups)} surface roles; at most 62 fit in one facet tag set.")
+    for i, facets in enumerate(groups):
+        facets = np.unique(np.asarray(facets, dtype=np.int32))
+        bits[facets] |= np.int64(1) << i
+    used = np.flatnonzero(bits)
+    combos = sorted(set().union(*domain.comm.allgather(set(np.unique(bits[used]).tolist()))))
+    value_of = {c: k + 1 for k, c in enumerate(combos)}
+    values = np.array([value_of[int(b)] for b in bits[used]], dtype=np.int32)
+    tags = mesh.meshtags(domain, fdim, used.astype(np.int32), values)
+    ids = [tuple(value_of[c] for c in combos if c >> i & 1) for i in range(len(groups))]
+    return tags, ids
