@@ -108,3 +108,46 @@ def test_picture_grid_is_the_whole_deformed_body_on_rank_0():
     lo, hi = np.array(grid.bounds).reshape(3, 2).T
     assert lo[:2] == pytest.approx([-3.3, 0.0]) and hi[:2] == pytest.approx([3.3, 1.0])
     assert grid.point_data["contact pressure"].shape == (grid.n_points,)
+
+
+class _Stop(Exception):
+    """Stands for a run stopped after a given step."""
+
+
+@pytest.mark.parametrize(("method", "r"), [("gnrm", 1.0), ("penalty", 100.0)])
+def test_a_resumed_frictional_run_repeats_the_uninterrupted_one(tmp_path, method, r):
+    """Friction has a history: lam_t, the last converged u and the obstacle's frame.
+
+    Stopped after step 6 of 10 (sticking and slipping nodes on the plane),
+    the resumed run must repeat every step of the uninterrupted one: the
+    same iterations and the same numbers to the last bit. (Without lam_t in
+    the checkpoint GNRM took 5 iterations at step 7 instead of 3; without
+    the obstacle's committed position the penalty method's regularised
+    stick traction jumped, F_t 5.51 instead of 5.19 at step 7.)
+    """
+    import dataclasses
+
+    from fenics_contact.runner import run_scene
+
+    scene = load_scene(SCENES / "block_slide_friction.toml")
+    scene = dataclasses.replace(
+        scene, solver=dataclasses.replace(scene.solver, method=method, steps=10),
+        contact=dataclasses.replace(scene.contact, r=r),
+    )
+    full = run_scene(scene, tmp_path / "full", comm=MPI.COMM_SELF, pictures=False)
+
+    def stop(step):
+        if step.step == 6:
+            raise _Stop
+
+    with pytest.raises(_Stop):
+        run_scene(scene, tmp_path / "part", comm=MPI.COMM_SELF, pictures=False, on_step=stop)
+    resumed = run_scene(scene, tmp_path / "part", comm=MPI.COMM_SELF, pictures=False,
+                        resume=True)
+    assert full.path.converged and resumed.path.converged
+    assert [s.step for s in resumed.path.steps] == list(range(1, 11))
+    for a, b in zip(full.path.steps, resumed.path.steps, strict=True):
+        assert (a.iterations, a.tangential_force, a.contact_force, a.stick_count) == (
+            b.iterations, b.tangential_force, b.contact_force, b.stick_count), a.step
+    assert np.array_equal(full.problem.u.x.array, resumed.problem.u.x.array)
+    assert 0 < full.path.steps[6].stick_count  # step 7 has sticking nodes: the history counts

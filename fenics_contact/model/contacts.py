@@ -225,6 +225,10 @@ class Contact:
         if tau is not None:
             self.friction.set_lam_t(tau)
 
+    def gap_origin(self) -> np.ndarray:
+        """The point the gap's coordinates are measured from (length; the origin here)."""
+        return np.zeros(self.gdim)
+
     def nodal_coordinates(self) -> np.ndarray:
         """Reference coordinates of the owned multiplier nodes, shape (n, 3)."""
         n = self.Q.dofmap.index_map.size_local

@@ -93,6 +93,10 @@ class ObstacleContact(Contact):
         times, offsets = self._schedule
         return np.array([np.interp(t, times, offsets[:, i]) for i in range(offsets.shape[1])])
 
+    def gap_origin(self) -> np.ndarray:
+        """The obstacle's reference point (length): the gap is measured from it."""
+        return np.asarray(self.obstacle.point.value, float)
+
     def set_load(self, t: float) -> None:
         """Place the obstacle at load factor t."""
         self.obstacle.translate_to(self.offset(t))

@@ -111,6 +111,8 @@ class ContactProblem:
         self.u = solid.u
         self.bcs = solid.bcs
         self.load_factor = 0.0
+        #: The load factor of the last :meth:`commit` (the start of the slip increment).
+        self.committed_load_factor = 0.0
         groups = [c.facets for c in self.contacts] + [t.facets for t in solid.tractions]
         self.facet_tags, ids = facet_roles(self.domain, groups)
         for contact, tag_ids in zip(self.contacts, ids, strict=False):
@@ -208,6 +210,11 @@ class ContactProblem:
         """Each contact's lam (<= 0, the pressure), in the order of the contacts."""
         return [c.lam for c in self.contacts]
 
+    @property
+    def multiplier_dofs(self) -> int:
+        """Global number of normal multiplier degrees of freedom over the contacts."""
+        return sum(c.surface.num_dofs for c in self.contacts)
+
     def multipliers(self) -> list[fem.Function]:
         """Every multiplier: each contact's lam, then each frictional contact's lam_t."""
         return self.normal_multipliers() + [f.lam_t for f in self._frictions()]
@@ -228,6 +235,30 @@ class ContactProblem:
     def stiffness_scale(self) -> float:
         """E/h of the first contact: the scale that makes r dimensionless (stress/length)."""
         return self.contact.stiffness_scale
+
+    @property
+    def h(self) -> float:
+        """The smallest contact facet size over the contacts (length)."""
+        return min(c.surface.h for c in self.contacts)
+
+    @property
+    def nodal_rule(self) -> bool:
+        """Whether every contact enforces its conditions at the nodes (the default rule)."""
+        return all(c.settings.quadrature == "nodal" for c in self.contacts)
+
+    @property
+    def entity_maps(self) -> list:
+        """The entity maps of every contact submesh (for forms on them)."""
+        return [m for c in self.contacts for m in c.surface.entity_maps]
+
+    def r_ratios(self) -> list[float]:
+        """Each contact's r over the first contact's r (1 for one contact)."""
+        return [float(c.r.value) / self.r_absolute for c in self.contacts]
+
+    def rescale_r(self, r: float) -> None:
+        """Set the first contact's r to ``r`` (absolute); the others keep their ratio to it."""
+        for c, ratio in zip(self.contacts, self.r_ratios(), strict=True):
+            c.r.value = ratio * r
 
     def set_r(self, r: float, *, relative: bool) -> None:
         """Set every contact's r, relative to its own E/h or absolute (stress/length)."""
@@ -279,8 +310,24 @@ class ContactProblem:
             for f in self._friction():
                 f.keep_penalty_traction()
         self.u_prev.x.array[:] = self.u.x.array
+        self.committed_load_factor = self.load_factor
         for c in self.contacts:
             c.commit_frame()
+
+    def restore_commit(self, committed_load_factor: float) -> None:
+        """Rebuild the last commit's slip frames from a restored u_prev (a resumed run).
+
+        The obstacles are placed at ``committed_load_factor`` while each
+        contact takes its frame, then put back at the current load factor.
+        """
+        if not self.frictional:
+            return
+        t = self.load_factor
+        self.set_load(committed_load_factor)
+        for c in self.contacts:
+            c.commit_frame()
+        self.committed_load_factor = float(committed_load_factor)
+        self.set_load(t)
 
     def snapshot(self) -> ProblemState:
         """Copy u, every multiplier and the load factor (see :meth:`restore`)."""
@@ -334,8 +381,7 @@ class ContactProblem:
         transfer = None
         if extras:
             transfer = transfers[0] if len(transfers) == 1 else Transfers(transfers)
-        entity_maps = [m for c in self.contacts for m in c.surface.entity_maps]
-        return VariationalSystem(name, residuals, unknowns, self.bcs, entity_maps,
+        return VariationalSystem(name, residuals, unknowns, self.bcs, self.entity_maps,
                                  extras=extras, transfer=transfer)
 
     def _lagrangian(self) -> ufl.Form:

@@ -39,39 +39,43 @@ DEFAULT_FORCE_RTOL = 1e-10
 def force_scale(problem: ContactProblem) -> float:
     """E h^(d-1): the force unit of the residual (force; per unit thickness in 2D)."""
     dim = problem.domain.geometry.dim
-    return float(problem.material.E * problem.surface.h ** (dim - 1))
+    return float(problem.material.E * problem.h ** (dim - 1))
 
 
 def gap_scale(problem: ContactProblem) -> float:
     """Size of the numbers the gap is computed from (length).
 
     The largest distance between a multiplier node (reference position plus
-    displacement bound given by the current state) and the obstacle's
-    reference point; at least the mean contact facet size.
+    displacement bound given by the current state) and the point its gap is
+    measured from (an obstacle's reference point; the origin for a
+    deformable pair, whose gap is a difference of coordinates), over every
+    contact; at least the smallest contact facet size.
     """
-    coords = problem.nodal_coordinates()[:, : problem.domain.geometry.dim]
     gdim = problem.domain.geometry.dim
-    # Two-body problems (no obstacle): the gap is a difference of coordinates.
-    obstacle = getattr(problem, "obstacle", None)
-    point = np.zeros(gdim) if obstacle is None else np.asarray(obstacle.point.value, float)
-    local = float(np.max(np.linalg.norm(coords - point, axis=1), initial=0.0))
+    local = max(
+        float(np.max(np.linalg.norm(c.nodal_coordinates()[:, :gdim] - c.gap_origin(), axis=1),
+                     initial=0.0))
+        for c in problem.contacts
+    )
     u_max = float(np.max(np.abs(problem.u.x.array), initial=0.0))
     scale = problem.comm.allreduce(local, op=MPI.MAX) + problem.comm.allreduce(u_max, op=MPI.MAX)
-    return max(scale, problem.surface.h)
+    return max(scale, problem.h)
 
 
 def area_norm(problem: ContactProblem) -> float:
-    """Euclidean norm of the lumped nodal areas of the contact surface (area)."""
-    local = float(problem.surface.lumped_area @ problem.surface.lumped_area)
+    """Euclidean norm of the lumped nodal areas of every contact surface (area)."""
+    local = sum(float(c.surface.lumped_area @ c.surface.lumped_area) for c in problem.contacts)
     return math.sqrt(problem.comm.allreduce(local, op=MPI.SUM))
 
 
 def residual_floor(problem: ContactProblem, r: float | None = None) -> float:
     """Round-off floor of the static residual at ``r`` (absolute; default: current r).
 
-    Returns ``FLOOR_FACTOR * eps * r * g_scale * ||A||`` (force units).
+    ``r`` is the first contact's; the others keep their ratio to it and the
+    largest r counts. Returns ``FLOOR_FACTOR * eps * r * g_scale * ||A||``
+    (force units).
     """
-    r_abs = problem.r_absolute if r is None else float(r)
+    r_abs = (problem.r_absolute if r is None else float(r)) * max(problem.r_ratios())
     eps = float(np.finfo(float).eps)
     return FLOOR_FACTOR * eps * r_abs * gap_scale(problem) * area_norm(problem)
 

@@ -47,7 +47,7 @@ from fenics_contact.output.io import _clean, write_json
 from fenics_contact.scene.schema import Scene
 
 #: Checkpoint layout version; a reader refuses others.
-FORMAT = 2
+FORMAT = 3
 #: Scene fields that cannot change the answer (a resume may change them).
 _FREE_SCENE_KEYS = frozenset({"path", "name", "description", "fields", "pictures"})
 #: Solver settings that change the answer; the others (tolerances, limits, predictor,
@@ -55,8 +55,8 @@ _FREE_SCENE_KEYS = frozenset({"path", "name", "description", "fields", "pictures
 _ANSWER_SOLVER_KEYS = ("method", "steps")
 LATEST = "latest.json"
 _KEYS = {
-    "u", "lam", "load_factor", "history_t", "history_u", "history_lam", "u_coordinates",
-    "lam_coordinates",
+    "u", "load_factor", "committed_load_factor", "history_t", "history_u", "history_lam",
+    "u_coordinates",
 }
 
 
@@ -190,6 +190,39 @@ def _owned_coordinates(f: fem.Function) -> np.ndarray:
     return f.function_space.tabulate_dof_coordinates()[: im.size_local]
 
 
+def _state_functions(problem: ContactProblem) -> dict[str, fem.Function]:
+    """Every field a resume needs, by key: u, each multiplier, the last converged u.
+
+    The multipliers are each contact's lam, then each frictional contact's
+    lam_t (the penalty method's committed traction); ``u_prev`` is the
+    start of the slip increment (friction only).
+    """
+    fields = {"u": problem.u}
+    fields |= {f"multiplier_{i}": m for i, m in enumerate(problem.multipliers())}
+    if problem.u_prev is not None:
+        fields["u_prev"] = problem.u_prev
+    return fields
+
+
+def _owned_joined(problem: ContactProblem, joined: np.ndarray) -> np.ndarray:
+    """The owned parts of a joined array of the normal multipliers (ghosts included)."""
+    parts, start = [], 0
+    for m in problem.normal_multipliers():
+        parts.append(joined[start:start + _owned(m).size])
+        start += m.x.array.size
+    return np.concatenate(parts)
+
+
+def _full_joined(problem: ContactProblem, owned: np.ndarray) -> np.ndarray:
+    """Inverse of :func:`_owned_joined`: the joined full local arrays."""
+    parts, start = [], 0
+    for m in problem.normal_multipliers():
+        n = _owned(m).size
+        parts.append(_full(m, owned[start:start + n]))
+        start += n
+    return np.concatenate(parts)
+
+
 def _rank_file(folder: Path, step: int, rank: int) -> Path:
     return folder / f"step_{step:04d}" / f"rank_{rank:04d}.npz"
 
@@ -217,8 +250,8 @@ class CheckpointWriter:
             folder.mkdir(parents=True, exist_ok=True)
         comm.Barrier()
         self._coordinates = {
-            "u_coordinates": _owned_coordinates(problem.u),
-            "lam_coordinates": _owned_coordinates(problem.lam),
+            f"{key}_coordinates": _owned_coordinates(f)
+            for key, f in _state_functions(problem).items() if key != "u_prev"
         }
         #: Fingerprints [size, sha256] of the finished steps' files, by path in the run folder.
         self._files: dict[str, list] = {}
@@ -241,18 +274,20 @@ class CheckpointWriter:
         p = self.problem
         comm = p.comm
         path = _rank_file(self.folder, step, comm.rank)
-        nu, nl = _owned(p.u).size, _owned(p.lam).size
+        nu = _owned(p.u).size
+        nl = sum(_owned(m).size for m in p.normal_multipliers())
         failure = None
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
             np.savez(
                 path,
-                u=_owned(p.u),
-                lam=_owned(p.lam),
+                **{key: _owned(f) for key, f in _state_functions(p).items()},
                 load_factor=np.float64(p.load_factor),
+                committed_load_factor=np.float64(p.committed_load_factor),
                 history_t=np.array([h[0] for h in history], dtype=np.float64),
                 history_u=np.array([h[1][:nu] for h in history]).reshape(len(history), nu),
-                history_lam=np.array([h[2][:nl] for h in history]).reshape(len(history), nl),
+                history_lam=np.array([_owned_joined(p, h[2]) for h in history]).reshape(
+                    len(history), nl),
                 **self._coordinates,
             )
         except OSError as exc:
@@ -304,11 +339,14 @@ def restore(folder: Path, problem: ContactProblem, marker: dict) -> Checkpoint:
             data = {k: npz[k] for k in npz.files}
     except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
         problem_here = f"process {comm.rank}: {path} is damaged or unreadable ({exc})"
-    missing = sorted(_KEYS - set(data))
+    fields = _state_functions(problem)
+    missing = sorted((_KEYS | set(fields)) - set(data))
     if problem_here is None and missing:
         problem_here = f"process {comm.rank}: {path} lacks {missing}"
     if problem_here is None:
-        for name, f in (("u", problem.u), ("lam", problem.lam)):
+        for name, f in fields.items():
+            if name == "u_prev":
+                continue
             mine = _owned_coordinates(f)
             saved = data[f"{name}_coordinates"]
             if saved.shape != mine.shape or not np.allclose(saved, mine, rtol=0, atol=1e-12 * (
@@ -326,11 +364,12 @@ def restore(folder: Path, problem: ContactProblem, marker: dict) -> Checkpoint:
             f"Checkpoint {folder} (step {step}) does not fit this scene: {'; '.join(problems)}. "
             "Run without --resume to start afresh."
         )
-    problem.u.x.array[:] = _full(problem.u, data["u"])
-    problem.lam.x.array[:] = _full(problem.lam, data["lam"])
+    for name, f in fields.items():
+        f.x.array[:] = _full(f, data[name])
     problem.set_load(float(data["load_factor"]))
+    problem.restore_commit(float(data["committed_load_factor"]))
     history = [
-        (float(t), _full(problem.u, hu), _full(problem.lam, hl))
+        (float(t), _full(problem.u, hu), _full_joined(problem, hl))
         for t, hu, hl in zip(data["history_t"], data["history_u"], data["history_lam"],
                              strict=True)
     ]

@@ -131,7 +131,7 @@ class AutoStrategy(NewtonStrategy):
         """The r values solved in turn (absolute); the last one decides the answer."""
         r_user = self.problem.r_absolute
         r_work = self.working_r()
-        if self.problem.settings.quadrature == "nodal" or r_user <= r_work:
+        if self.problem.nodal_rule or r_user <= r_work:
             return [r_work]
         count = math.ceil(math.log(r_user / r_work) / math.log(self.auto.continuation_factor))
         return [*np.geomspace(r_work, r_user, count + 1)[:-1].tolist(), r_user]
@@ -152,14 +152,14 @@ class AutoStrategy(NewtonStrategy):
                     f"({rungs[0] / p.stiffness_scale:.3g} E/h)"
                 )
             for r in rungs:
-                p.r.value = r
+                p.rescale_r(r)
                 status = self._rung(tally, self._stage_settings(r_user))
                 if status is not Status.CONVERGED:
                     break
             if status is Status.CONVERGED and rungs[-1] != r_user:
                 self._check_user_r(r_user, tally)
         finally:
-            p.r.value = r_user
+            p.rescale_r(r_user)
         return SolveResult(
             status, tally.iterations, 0, self._linear_solves() - solves_before,
             tally.residuals, switches=tally.switches,
@@ -191,7 +191,7 @@ class AutoStrategy(NewtonStrategy):
     def _check_user_r(self, r_user: float, tally: _Tally) -> None:
         """Nodal rule: evaluate the residual at the user's r against its floor."""
         p = self.problem
-        p.r.value = r_user
+        p.rescale_r(r_user)
         settings = self._stage_settings(r_user)
         norm = self.kernel.assemble_residual()
         tolerance = settings.atol

@@ -254,33 +254,41 @@ def signorini_admissibility(
     (an integral constraint whose answer depends on r) there is no such
     test and None is returned.
     """
-    from mpi4py import MPI
-
-    if problem.surface.quadrature != "nodal":
+    if not problem.nodal_rule:
         return None
-
-    h = float(problem.surface.h)
     E = float(problem.material.E)
+    contacts = problem.contacts
 
     def check() -> str | None:
-        state = problem.contact_state()
-        tension = problem.comm.allreduce(
-            float(np.max(state.multiplier, initial=0.0)), op=MPI.MAX
-        )
-        inside = state.max_penetration
-        constraint = inside if state.constraint_penetration is None else (
-            state.constraint_penetration
-        )
-        violation = _first_violation(
-            settings, h, E, [("penetration", constraint)], [("tension", tension)]
-        )
-        two_body = state.constraint_penetration is not None
-        if violation is None and two_body and inside > settings.surface_tol * h:
-            violation = (f"penetration into the target surface {inside:.3g} > surface_tol * h = "
-                         f"{settings.surface_tol:g} * {h:.3g}")
-        return violation
+        for contact in contacts:
+            violation = _signorini_violation(contact, settings, E)
+            if violation is not None:
+                prefix = f"{contact.name}: " if len(contacts) > 1 else ""
+                return prefix + violation
+        return None
 
     return check
+
+
+def _signorini_violation(contact, settings: SolverSettings, E: float) -> str | None:
+    """The first Signorini violation of one contact (its own h), or None."""
+    from mpi4py import MPI
+
+    h = float(contact.surface.h)
+    state = contact.contact_state()
+    tension = contact.comm.allreduce(float(np.max(state.multiplier, initial=0.0)), op=MPI.MAX)
+    inside = state.max_penetration
+    constraint = inside if state.constraint_penetration is None else (
+        state.constraint_penetration
+    )
+    violation = _first_violation(
+        settings, h, E, [("penetration", constraint)], [("tension", tension)]
+    )
+    two_body = state.constraint_penetration is not None
+    if violation is None and two_body and inside > settings.surface_tol * h:
+        violation = (f"penetration into the target surface {inside:.3g} > surface_tol * h = "
+                     f"{settings.surface_tol:g} * {h:.3g}")
+    return violation
 
 
 def coulomb_admissibility(
@@ -297,9 +305,9 @@ def coulomb_admissibility(
     Coulomb disc at most ``settings.tension_tol * E``; else a sentence naming
     the violation. None (no test) without friction or with the Gauss rule.
     """
-    if not problem.frictional or problem.surface.quadrature != "nodal":
+    if not problem.frictional or not problem.nodal_rule:
         return None
-    h = float(problem.surface.h)
+    h = float(problem.h)
     E = float(problem.material.E)
 
     def check() -> str | None:
@@ -321,7 +329,7 @@ def prescribed_admissibility(
     """
     if not problem.bcs:
         return None
-    h = float(problem.surface.h)
+    h = float(problem.h)
 
     def check() -> str | None:
         return _first_violation(

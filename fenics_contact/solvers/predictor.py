@@ -53,7 +53,17 @@ class Extrapolated:
         return self.inner.kernel  # type: ignore[attr-defined]
 
     def _state(self) -> tuple[np.ndarray, np.ndarray]:
-        return self.problem.u.x.array, self.problem.lam.x.array
+        """The u array itself and every contact's lam joined (a copy for several)."""
+        multipliers = self.problem.normal_multipliers()
+        if len(multipliers) == 1:
+            return self.problem.u.x.array, multipliers[0].x.array
+        return self.problem.u.x.array, np.concatenate([m.x.array for m in multipliers])
+
+    def _set_multipliers(self, values: np.ndarray) -> None:
+        start = 0
+        for m in self.problem.normal_multipliers():
+            m.x.array[:] = values[start:start + m.x.array.size]
+            start += m.x.array.size
 
     def _record(self) -> None:
         u, lam = self._state()
@@ -92,9 +102,9 @@ class Extrapolated:
             return False
         (t0, u0, lam0), (t1, u1, lam1) = self._history
         s = (self.problem.load_factor - t1) / (t1 - t0)
-        u, lam = self._state()
+        u, _ = self._state()
         u[:] = u1 + s * (u1 - u0)
-        lam[:] = lam1 + s * (lam1 - lam0)
+        self._set_multipliers(lam1 + s * (lam1 - lam0))
         return True
 
     def solve(self) -> SolveResult:

@@ -232,7 +232,7 @@ def start_record(strategy: Strategy) -> RunRecord:
         r_absolute=problem.r_absolute,
         r_relative=problem.r_relative,
         displacement_dofs=V.dofmap.index_map.size_global * V.dofmap.index_map_bs,
-        multiplier_dofs=problem.surface.num_dofs,
+        multiplier_dofs=problem.multiplier_dofs,
         processes=problem.comm.size,
     )
 

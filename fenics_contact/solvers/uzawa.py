@@ -31,7 +31,7 @@ class UzawaBase(NewtonStrategy):
         residual = problem.complementarity_residual()
         # a frictional problem gives the normal and the tangential residual
         self._complementarity = [
-            fem.form(form, entity_maps=problem.surface.entity_maps)
+            fem.form(form, entity_maps=problem.entity_maps)
             for form in (residual if isinstance(residual, list) else [residual])
         ]
         self.primal_norm = math.inf

@@ -244,6 +244,34 @@ class StrikerOnFacetProblem:
         self.striker.value[:] = self._start + t * self._motion
         self.solid.set_load(t)
 
+    @property
+    def h(self) -> float:
+        """The target facet's length: the length scale of the checks."""
+        return self.surface.h
+
+    #: The point measure sits at the striker node.
+    nodal_rule = True
+    name = "striker"
+
+    @property
+    def contacts(self) -> list[StrikerOnFacetProblem]:
+        """The one contact: the problem itself (its surface, state and comm)."""
+        return [self]
+
+    @property
+    def entity_maps(self) -> list:
+        """The target facet submesh's entity map."""
+        return self.surface.entity_maps
+
+    @property
+    def multiplier_dofs(self) -> int:
+        """One: the striker's force."""
+        return self.surface.num_dofs
+
+    def rescale_r(self, r: float) -> None:
+        """Set r (absolute, force per length: one contact)."""
+        self.r.value = r
+
     def set_r(self, r: float, *, relative: bool) -> None:
         """Set r, relative to E/L or absolute (stress per length)."""
         check_r(r)
