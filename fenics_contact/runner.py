@@ -51,23 +51,36 @@ def _summary(scene: Scene, record: RunRecord) -> dict:
         "pairs": [
             {
                 "name": pair.name, "striker": pair.striker, "target": pair.target,
-                "mu": pair.mu,
-                "steps": [
-                    {"step": s.step, "load_factor": s.load_factor,
-                     "normal_force": s.contact_force, "active_count": s.active_count,
-                     "max_penetration": s.max_penetration,
-                     **({"tangential_force": s.tangential_force, "stick_count": s.stick_count,
-                         "slip_count": s.slip_count} if pair.mu is not None else {})}
-                    for s in record.steps
-                ],
+                "mu": pair.mu, "steps": _contact_steps(record, pair.name, pair.mu is not None),
             }
             for pair in scene.pairs
-        ] if scene.two_body else [],
+        ],
+        "obstacles": [
+            {
+                "name": o.name, "type": o.obstacle.type, "tag": o.contact.tag, "r": o.contact.r,
+                "mu": o.contact.mu,
+                "steps": _contact_steps(record, o.name, o.contact.mu is not None),
+            }
+            for o in scene.obstacles
+        ],
         "bodies": [
             {"name": b.name, "tag": b.tag, "law": b.law, "E": b.E, "nu": b.nu}
             for b in scene.bodies
         ],
     }
+
+
+_FRICTION_KEYS = ("tangential_force", "stick_count", "slip_count")
+
+
+def _contact_steps(record: RunRecord, name: str, frictional: bool) -> list[dict]:
+    """One contact's numbers at each finished step (friction counts only with mu)."""
+    return [
+        {"step": s.step, "load_factor": s.load_factor,
+         **{k: v for k, v in s.contacts.get(name, {}).items()
+            if frictional or k not in _FRICTION_KEYS}}
+        for s in record.steps
+    ]
 
 
 def _write_summary(comm: MPI.Comm, out: Path, scene: Scene, record: RunRecord) -> dict:
@@ -152,7 +165,7 @@ def run_scene(
         )
         if comm.rank == 0:
             step_residuals(path.steps, out / "residuals.png", title=scene.name)
-        if scene.contact.mu is not None:
+        if scene.frictional:
             from fenics_contact.output.friction_plot import friction_profile
 
             friction_profile(

@@ -127,6 +127,7 @@ class ContactProblem:
         if external is not None:
             self.potential -= external
         self._multiplier_is_pressure = True
+        self._shared_nodes: int | None = None
 
     # -- the first contact's objects ------------------------------------------------
     @property
@@ -163,6 +164,26 @@ class ContactProblem:
     def obstacle(self) -> RigidObstacle | None:
         """The first contact's rigid obstacle, None for a deformable pair."""
         return getattr(self.contact, "obstacle", None)
+
+    @property
+    def shared_contact_nodes(self) -> int:
+        """Global number of body vertices on the surfaces of two or more contacts."""
+        if len(self.contacts) < 2:
+            return 0
+        if self._shared_nodes is None:
+            V = fem.functionspace(self.domain, ("Lagrange", 1))
+            index_map = V.dofmap.index_map
+            on_surface = []
+            for c in self.contacts:  # the global vertices of each surface, on every rank
+                local = index_map.local_to_global(c.surface.parent_dofs(V).astype(np.int32))
+                on_surface.append(np.unique(np.concatenate(self.comm.allgather(local))))
+            joined = np.concatenate(on_surface)
+            self._shared_nodes = int(joined.size - np.unique(joined).size)
+        return self._shared_nodes
+
+    def obstacles(self) -> list[RigidObstacle]:
+        """Every rigid obstacle the contacts press against, in the order of the contacts."""
+        return [c.obstacle for c in self.contacts if isinstance(c, ObstacleContact)]
 
     @property
     def pair(self):
@@ -580,6 +601,7 @@ def two_body_problem(
     tractions: Sequence[SurfaceTraction] = (),
     degree: int = 1,
     friction: FrictionSettings | None = None,
+    name: str = "pair",
 ) -> ContactProblem:
     """Bodies of one mesh with one node-to-segment pair (striker against target)."""
     from fenics_contact.model.pairs import NodeToSegmentContact
@@ -587,7 +609,7 @@ def two_body_problem(
     solid = Solid(domain, bodies, cell_tags, prescribed=prescribed, tractions=tractions,
                   degree=degree)
     contact = NodeToSegmentContact(striker_facets, target_facets, settings, striker=striker,
-                                   target=target, friction=friction)
+                                   target=target, friction=friction, name=name)
     return ContactProblem(solid, [contact])
 
 

@@ -68,6 +68,15 @@ class ContactState:
     stick_count: int = 0
     slip_count: int = 0
 
+    def summary(self) -> dict[str, float | int]:
+        """The global numbers of the state (for a step's record): forces, counts, depth."""
+        return {
+            "normal_force": self.contact_force, "active_count": self.active_count,
+            "max_penetration": self.max_penetration,
+            "tangential_force": self.tangential_force, "stick_count": self.stick_count,
+            "slip_count": self.slip_count,
+        }
+
     @classmethod
     def gathered(
         cls,

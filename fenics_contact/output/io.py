@@ -58,17 +58,20 @@ def write_csv(path: Path, rows: Iterable[Mapping[str, object]]) -> None:
 
 
 class SurfaceToBody:
-    """Copies nodal values on the contact submesh into a P1 field on the body.
+    """Copies nodal values on a contact submesh into a P1 field on the body.
 
     Each multiplier node is mapped to its own parent vertex through the
     submesh's node map (never by coordinates: two bodies meshed touching have
     distinct vertices at one point); body nodes off the contact surface keep
-    the fill value.
+    the fill value. ``contact``: which contact (default the first); ``W``:
+    the body's P1 space to share with other mappers.
     """
 
-    def __init__(self, problem: ContactProblem) -> None:
-        self.W = fem.functionspace(problem.domain, ("Lagrange", 1))
-        self.body_dofs = problem.surface.parent_dofs(self.W).astype(np.int32)
+    def __init__(self, problem: ContactProblem, contact=None,
+                 W: fem.FunctionSpace | None = None) -> None:
+        contact = problem.contacts[0] if contact is None else contact
+        self.W = fem.functionspace(problem.domain, ("Lagrange", 1)) if W is None else W
+        self.body_dofs = contact.surface.parent_dofs(self.W).astype(np.int32)
 
     def field(self, name: str, values: np.ndarray, fill: float = 0.0) -> fem.Function:
         """A body P1 function holding ``values`` (all local surface dofs) on the surface."""
@@ -88,5 +91,55 @@ class SurfaceToBody:
         f = fem.Function(self._Wv, name=name)
         for i in range(gdim):
             f.x.array[self.body_dofs * gdim + i] = values[:, i]
+        return f
+
+
+class ContactsToBody:
+    """Every contact's owned nodal values as one body P1 field (contacts in order).
+
+    Off every contact surface the field is zero. Where two contacts share a
+    node (a body touching two obstacles at a corner) pressures and tractions
+    add; other values are the later contact's.
+    """
+
+    def __init__(self, problem: ContactProblem) -> None:
+        self.W = fem.functionspace(problem.domain, ("Lagrange", 1))
+        self._maps = [(SurfaceToBody(problem, c, self.W), fem.Function(c.Q))
+                      for c in problem.contacts]
+        self._Wv: fem.FunctionSpace | None = None
+
+    def _local(self, values: np.ndarray, q: fem.Function) -> np.ndarray:
+        """Owned values of one contact, ghosts filled in (all local surface dofs)."""
+        q.x.array[:] = 0.0
+        q.x.array[: values.size] = values
+        q.x.scatter_forward()
+        return q.x.array
+
+    def field(self, name: str, per_contact: list[np.ndarray], *, add: bool = False
+              ) -> fem.Function:
+        """A body P1 function from each contact's owned nodal values."""
+        f = fem.Function(self.W, name=name)
+        for (mapper, q), values in zip(self._maps, per_contact, strict=True):
+            local = self._local(values, q)
+            if add:
+                f.x.array[mapper.body_dofs] += local
+            else:
+                f.x.array[mapper.body_dofs] = local
+        return f
+
+    def vector_field(self, name: str, per_contact: list[np.ndarray], *, add: bool = False
+                     ) -> fem.Function:
+        """A body vector P1 function from each contact's owned nodal vectors (n, gdim)."""
+        gdim = self.W.mesh.geometry.dim
+        if self._Wv is None:
+            self._Wv = fem.functionspace(self.W.mesh, ("Lagrange", 1, (gdim,)))
+        f = fem.Function(self._Wv, name=name)
+        blocks = f.x.array.reshape(-1, gdim)
+        for (mapper, q), values in zip(self._maps, per_contact, strict=True):
+            local = np.column_stack([self._local(values[:, i], q).copy() for i in range(gdim)])
+            if add:
+                blocks[mapper.body_dofs] += local
+            else:
+                blocks[mapper.body_dofs] = local
         return f
 

@@ -11,17 +11,16 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from dolfinx import fem, plot
+from dolfinx import plot
 
-from fenics_contact.model.obstacles import RigidBall, RigidPlane
+from fenics_contact.model.obstacles import RigidBall, RigidObstacle, RigidPlane
 from fenics_contact.model.problem import ContactProblem
-from fenics_contact.output.io import SurfaceToBody
+from fenics_contact.output.io import ContactsToBody
 
 
-def _obstacle_mesh(problem: ContactProblem, bounds: np.ndarray):
+def _obstacle_mesh(problem: ContactProblem, obstacle: RigidObstacle, bounds: np.ndarray):
     import pyvista
 
-    obstacle = problem.obstacle
     gdim = problem.domain.geometry.dim
     centre = np.zeros(3)
     centre[:gdim] = obstacle.point.value
@@ -67,12 +66,8 @@ def _gathered_grid(problem: ContactProblem):
     """
     import pyvista
 
-    mapper = SurfaceToBody(problem)
-    state = problem.contact_state()
-    q = fem.Function(problem.Q)
-    q.x.array[: state.pressure.size] = -state.pressure
-    q.x.scatter_forward()
-    pressure = mapper.field("p", q.x.array)
+    pressures = [-c.contact_state().pressure for c in problem.contacts]
+    pressure = ContactsToBody(problem).field("p", pressures, add=True)
     topology, cell_types, geometry = plot.vtk_mesh(problem.V)
     gdim = problem.domain.geometry.dim
     points = np.array(geometry, dtype=np.float64).reshape(-1, 3)
@@ -136,9 +131,9 @@ def deformed_contact_picture(problem: ContactProblem, path: Path, title: str = "
                 render_points_as_spheres=True, point_size=9 if column else 6,
                 show_scalar_bar=False,
             )
-        if problem.obstacle is not None:  # two-body problems: both bodies are the grid
+        for obstacle in problem.obstacles():  # deformable partners are in the grid
             plotter.add_mesh(
-                _obstacle_mesh(problem, bounds), color="#555555", line_width=3,
+                _obstacle_mesh(problem, obstacle, bounds), color="#555555", line_width=3,
                 opacity=1.0 if gdim == 2 else 0.25,
             )
         if gdim == 2:

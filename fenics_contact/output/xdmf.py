@@ -31,7 +31,7 @@ from dolfinx import fem, io
 from fenics_contact.model.materials import von_mises
 from fenics_contact.model.problem import ContactProblem
 from fenics_contact.output.folders import agree, write_failure
-from fenics_contact.output.io import SurfaceToBody
+from fenics_contact.output.io import ContactsToBody
 from fenics_contact.scene.schema import FIELDS, FRICTION_FIELDS
 
 _STEP = re.compile(r"step_(\d{4,})\.(h5|xdmf)$")
@@ -164,8 +164,7 @@ class StepWriter:
         error = comm.bcast(error, root=0)
         if error is not None:
             raise ValueError(error)
-        self.mapper = SurfaceToBody(problem)
-        self._q = fem.Function(problem.Q)
+        self.mapper = ContactsToBody(problem)
         self._stress = None
         S = fem.functionspace(problem.domain, ("DG", 0))
         # Each body's law on its own cells; several bodies add a body-id field.
@@ -200,33 +199,39 @@ class StepWriter:
         else:  # no index until the first step is on disk
             self.path.unlink(missing_ok=True)
 
-    def _surface_field(self, name: str, values: np.ndarray) -> fem.Function:
-        self._q.x.array[: values.size] = values
-        self._q.x.scatter_forward()
-        return self.mapper.field(name, self._q.x.array)
+    def _contact_values(self) -> tuple[dict[str, list[np.ndarray]], dict[str, list[np.ndarray]]]:
+        """Each contact's owned nodal values by field name: scalars, then vectors.
 
-    def _surface_vector(self, name: str, values: np.ndarray) -> fem.Function:
-        """Nodal vectors (surface dofs x gdim) as a body P1 vector field."""
-        local = np.column_stack([
-            self._surface_field("c", values[:, i]).x.array[self.mapper.body_dofs]
-            for i in range(values.shape[1])
-        ])
-        return self.mapper.vector_field(name, local)
+        A frictionless contact of a frictional problem writes no traction or
+        slip and marks its pressed nodes as slipping (2): nothing holds them.
+        """
+        scalars: dict[str, list[np.ndarray]] = {
+            "contact_pressure": [], "gap": [], "active": [], "stick_slip": []}
+        vectors: dict[str, list[np.ndarray]] = {"tangential_traction": [], "slip": []}
+        friction = any(name in FRICTION_FIELDS for name in self.fields)
+        for contact in self.problem.contacts:
+            state = contact.contact_state()
+            scalars["contact_pressure"].append(state.pressure)
+            scalars["gap"].append(state.gap)
+            scalars["active"].append(state.active.astype(float))
+            if not friction:
+                continue
+            if contact.friction is None:
+                zero = np.zeros((state.gap.size, self.problem.gdim))
+                vectors["tangential_traction"].append(zero)
+                vectors["slip"].append(zero)
+                scalars["stick_slip"].append(2.0 * state.active)
+            else:
+                traction, slip = contact.friction.tangential_fields()
+                vectors["tangential_traction"].append(traction)
+                vectors["slip"].append(slip)
+                scalars["stick_slip"].append(state.node_state.astype(float))
+        return scalars, vectors
 
     def write(self, t: float) -> None:
         """Write the current fields at load factor ``t`` as the next step (collective)."""
         p = self.problem
-        state = p.contact_state()
-        surface = {
-            "contact_pressure": state.pressure,
-            "gap": state.gap,
-            "active": state.active.astype(float),
-        }
-        vectors: dict[str, np.ndarray] = {}
-        if any(name in FRICTION_FIELDS for name in self.fields):
-            traction, slip = p.tangential_fields()  # type: ignore[attr-defined]
-            surface["stick_slip"] = state.node_state.astype(float)  # type: ignore[attr-defined]
-            vectors = {"tangential_traction": traction, "slip": slip}
+        surface, vectors = self._contact_values()
         step_xdmf = self.folder / f"{_step_name(self.step)}.xdmf"
         failure = None
         try:
@@ -244,9 +249,11 @@ class StepWriter:
                                 self._stress.interpolate(expr, cells0=cells)
                         file.write_function(self._stress, t)
                     elif name in vectors:
-                        file.write_function(self._surface_vector(name, vectors[name]), t)
+                        file.write_function(self.mapper.vector_field(
+                            name, vectors[name], add=name == "tangential_traction"), t)
                     else:
-                        file.write_function(self._surface_field(name, surface[name]), t)
+                        file.write_function(self.mapper.field(
+                            name, surface[name], add=name == "contact_pressure"), t)
                 if self._body_id is not None:
                     file.write_function(self._body_id, t)
                     file.write_function(p.target_force(), t)

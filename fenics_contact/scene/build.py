@@ -20,14 +20,15 @@ from mpi4py import MPI
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.friction import FrictionSettings
 from fenics_contact.model.materials import material
+from fenics_contact.model.obstacle_contact import ObstacleContact
 from fenics_contact.model.obstacles import RigidBall, RigidObstacle, RigidPlane
 from fenics_contact.model.problem import (
     Body,
     ContactProblem,
     PathDisplacement,
     PrescribedDisplacement,
+    Solid,
     SurfaceTraction,
-    one_body_problem,
     two_body_problem,
 )
 from fenics_contact.model.rigid import free_rigid_motions
@@ -39,7 +40,14 @@ from fenics_contact.scene.checks import (
     check_pair_surfaces,
 )
 from fenics_contact.scene.meshing import mesh_on_rank, open_geo
-from fenics_contact.scene.schema import GENERATOR_TAGS, BoundarySpec, Scene, SceneError
+from fenics_contact.scene.schema import (
+    GENERATOR_TAGS,
+    BoundarySpec,
+    ObstacleContactSpec,
+    ObstacleSpec,
+    Scene,
+    SceneError,
+)
 
 
 @dataclass
@@ -129,8 +137,8 @@ def _check_tags(scene: Scene, groups: dict[tuple[int, int], str]) -> None:
     numbers = {tag for (d, tag) in groups if d == fdim}
     uses = [(f"dirichlet {i + 1}", b.tag) for i, b in enumerate(scene.dirichlet)]
     uses += [(f"traction {i + 1}", b.tag) for i, b in enumerate(scene.tractions)]
-    if scene.contact.tag is not None:
-        uses.append(("contact", scene.contact.tag))
+    uses += [(_contact_section(o), o.contact.tag) for o in scene.obstacles
+             if o.contact.tag is not None]
     listing = ", ".join(
         (f"{n} = {t}" if n else str(t))
         for t, n in sorted((t, groups[(fdim, t)]) for t in numbers)
@@ -213,26 +221,45 @@ def _restricted(body: BodyMesh, facets: np.ndarray, spec: BoundarySpec) -> np.nd
     return facets[keep]
 
 
-def build_obstacle(scene: Scene, domain: mesh.Mesh) -> RigidObstacle:
-    """The scene's rigid obstacle, placed by dolfinx Constants."""
-    spec = scene.obstacle
+def _contact_section(entry: ObstacleContactSpec) -> str:
+    """Where an obstacle's contact keys sit in the scene file (for messages)."""
+    return "contact" if entry.name == "obstacle" else f"obstacle '{entry.name}'"
+
+
+def build_obstacle(spec: ObstacleSpec, domain: mesh.Mesh) -> RigidObstacle:
+    """A rigid obstacle of the scene, placed by dolfinx Constants."""
     if spec.type == "plane":
         return RigidPlane(domain, spec.point, spec.normal)
     return RigidBall(domain, spec.point, spec.radius, inside=spec.inside)
 
 
-def contact_facets(scene: Scene, body: BodyMesh, obstacle: RigidObstacle) -> np.ndarray:
-    """Candidate contact facets: by tag, or detected along the obstacle's path."""
-    spec = scene.contact
+def contact_facets(
+    scene: Scene, body: BodyMesh, entry: ObstacleContactSpec, obstacle: RigidObstacle
+) -> np.ndarray:
+    """Candidate facets of one obstacle: by tag, or detected along the obstacle's path."""
+    spec = entry.contact
     if spec.tag is not None:
-        return tagged_facets(body, scene, "contact", spec.tag)
+        return tagged_facets(body, scene, _contact_section(entry), spec.tag)
     from fenics_contact.model.candidates import detect_candidate_facets
 
     pushes = [abs(v) for d in scene.dirichlet for v in d.value if v is not None]
     pushes += [abs(v) for d in scene.dirichlet for knot in d.path for v in knot[1:]]
     return detect_candidate_facets(
-        body.domain, obstacle, scene.obstacle.motion, spec.margin,
+        body.domain, obstacle, entry.obstacle.motion, spec.margin,
         displacement_bound=max(pushes, default=0.0),
+    )
+
+
+def obstacle_contact(scene: Scene, body: BodyMesh, entry: ObstacleContactSpec) -> ObstacleContact:
+    """One [[obstacle]] (or [obstacle] with [contact]) as a contact of the body."""
+    obstacle = build_obstacle(entry.obstacle, body.domain)
+    spec = entry.contact
+    friction = None if spec.mu is None else FrictionSettings(spec.mu, spec.tangential_r_max)
+    return ObstacleContact(
+        obstacle, contact_facets(scene, body, entry, obstacle),
+        spec,  # a ContactSettings with the candidate and friction keys
+        motion=entry.obstacle.motion, schedule=entry.obstacle.schedule or None,
+        friction=friction, name=entry.name,
     )
 
 
@@ -295,7 +322,7 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
     problem = two_body_problem(
         body.domain, body.cell_tags, bodies, striker, target,
         ContactSettings(r=pair.r, relative=pair.relative),
-        prescribed=prescribed, tractions=tractions, friction=friction,
+        prescribed=prescribed, tractions=tractions, friction=friction, name=pair.name,
     )
     check_initial_overlap(scene, problem)
     return problem
@@ -314,21 +341,10 @@ def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProbl
         )
     prescribed, tractions = boundary_conditions(scene, body)
     check_rigid_motions(scene, body, prescribed)
-    obstacle = build_obstacle(scene, body.domain)
-    friction = (None if scene.contact.mu is None
-                else FrictionSettings(scene.contact.mu, scene.contact.tangential_r_max))
-    problem = one_body_problem(
-        body.domain,
-        material(scene.law, scene.E, scene.nu),
-        obstacle,
-        contact_facets(scene, body, obstacle),
-        scene.contact,  # a ContactSettings with the candidate and friction keys
-        prescribed=prescribed,
-        tractions=tractions,
-        obstacle_motion=scene.obstacle.motion,
-        obstacle_schedule=scene.obstacle.schedule or None,
-        friction=friction,
-    )
+    solid = Solid(body.domain, [Body("body", None, material(scene.law, scene.E, scene.nu))],
+                  prescribed=prescribed, tractions=tractions)
+    contacts = [obstacle_contact(scene, body, entry) for entry in scene.obstacles]
+    problem = ContactProblem(solid, contacts)
     warn_initial_penetration(scene, problem)
     return problem
 
@@ -350,26 +366,34 @@ def check_rigid_motions(
         )
 
 
-def initial_penetration(problem: ContactProblem) -> float:
-    """Largest penetration of the contact nodes into the obstacle at load factor 0 (length)."""
-    points = problem.nodal_coordinates()[:, : problem.domain.geometry.dim]
-    gap = problem.obstacle.gap_value(points) if points.size else np.zeros(0)
+def initial_penetration(contact: ObstacleContact) -> float:
+    """Largest penetration of a contact's nodes into its obstacle at load factor 0 (length)."""
+    points = contact.nodal_coordinates()[:, : contact.gdim]
+    gap = contact.obstacle.gap_value(points) if points.size else np.zeros(0)
     local = float(np.max(-np.minimum(gap, 0.0), initial=0.0))
-    return float(problem.comm.allreduce(local, op=MPI.MAX))
+    return float(contact.comm.allreduce(local, op=MPI.MAX))
 
 
 def warn_initial_penetration(scene: Scene, problem: ContactProblem) -> float:
-    """Warn (SceneWarning) when the body starts inside the obstacle by more than h."""
-    depth = initial_penetration(problem)
-    h = problem.surface.h
-    if depth > h:
+    """Warn (SceneWarning) when the body starts inside an obstacle by more than h.
+
+    Returns the largest initial depth over the obstacles (length).
+    """
+    deepest = 0.0
+    for contact in problem.contacts:
+        depth = initial_penetration(contact)
+        deepest = max(deepest, depth)
+        h = contact.surface.h
+        if depth <= h:
+            continue
+        which = "the obstacle" if len(problem.contacts) == 1 else f"obstacle '{contact.name}'"
         warnings.warn(
             SceneWarning(
-                f"{scene.path.name}: the body starts {depth:.4g} inside the obstacle, more "
+                f"{scene.path.name}: the body starts {depth:.4g} inside {which}, more "
                 f"than the contact facet size h = {h:.4g} ({depth / h:.3g} h); expect squashed "
                 "or inverted elements. Move [obstacle] point/centre so the gap at load 0 is "
                 ">= 0, and let [obstacle] motion or [[dirichlet]] values bring contact."
             ),
             stacklevel=2,
         )
-    return depth
+    return deepest

@@ -22,6 +22,10 @@ KEYS: dict[str, set[str]] = {
     "obstacle": {"type", "point", "normal", "centre", "radius", "inside", "motion", "schedule"},
     "contact": {"tag", "detect", "margin", "r", "relative", "quadrature", "mu",
                 "tangential_r_max"},
+    # one [[obstacle]] block: the obstacle, its contact and a name
+    "obstacles": {"name", "type", "point", "normal", "centre", "radius", "inside", "motion",
+                  "schedule", "tag", "detect", "margin", "r", "relative", "quadrature", "mu",
+                  "tangential_r_max"},
     "solver": {"method", "steps", "max_iterations", "atol", "rtol", "max_cutbacks", "predictor",
                "linear_solver"},
     "output": {"fields", "pictures"},

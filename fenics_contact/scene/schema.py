@@ -26,6 +26,10 @@ Layout (units are the user's; be consistent)::
                  tangential_r_max (cap of the tangential parameter r_t =
                  min(r, tangential_r_max E/L), L the extent of the contact
                  surface; default 2)
+    [[obstacle]] several obstacles instead of [obstacle] and [contact]: each
+                 block holds one obstacle's keys, its contact's keys (tag or
+                 detect, r, relative, quadrature, mu, tangential_r_max) and
+                 a name (default obstacle1, obstacle2, ...)
     [[body]]     name, tag (cell tag), law, E, nu      } two deformable bodies
     [[pair]]     striker, target (facet tags), r,     } instead of [material],
                  relative, mu, tangential_r_max       } [obstacle], [contact]
@@ -71,6 +75,7 @@ from fenics_contact.scene.spec import (
     BoundarySpec,
     ContactSpec,
     MeshSpec,
+    ObstacleContactSpec,
     ObstacleSpec,
     PairSpec,
     Scene,
@@ -301,7 +306,7 @@ def _contact(reader: _Reader) -> ContactSpec:
     detect = reader.flag("detect", False)
     if detect == ("tag" in reader.table):
         raise SceneError(
-            f"{reader.path.name}: [contact] needs either 'tag' (the candidate facets) "
+            f"{reader.path.name}: [{reader.section}] needs either 'tag' (the candidate facets) "
             "or 'detect = true' (found from the obstacle's path), not both or neither."
         )
     return ContactSpec(
@@ -395,14 +400,9 @@ def load_scene(path: Path | str) -> Scene:
     mesh_spec = _mesh(path, _table(path, data, "mesh"), dimension)
     dirichlet = tuple(_boundary(r, dimension, True) for r in _array(path, data, "dirichlet"))
     tractions = tuple(_boundary(r, dimension, False) for r in _array(path, data, "traction"))
-    obstacle = _obstacle(_table(path, data, "obstacle"), dimension)
-    contact = _contact(_table(path, data, "contact"))
-    if obstacle.schedule and contact.detect:
-        raise SceneError(
-            f"{path.name}: [contact] detect = true follows the obstacle's straight motion; "
-            "with [obstacle] schedule give the candidate facets by [contact] tag."
-        )
-    fields = _fields(output, contact.mu, "[contact]")
+    obstacles = _obstacles(path, data, dimension)
+    mu = next((o.contact.mu for o in obstacles if o.contact.mu is not None), None)
+    fields = _fields(output, mu, "[contact]")
     return Scene(
         path=path,
         name=str(head.table.get("name", path.stem)),
@@ -414,12 +414,57 @@ def load_scene(path: Path | str) -> Scene:
         nu=nu,
         dirichlet=dirichlet,
         tractions=tractions,
-        obstacle=obstacle,
-        contact=contact,
+        obstacle=obstacles[0].obstacle,
+        contact=obstacles[0].contact,
         solver=_solver(_table(path, data, "solver", required=False)),
         fields=tuple(fields),
         pictures=output.flag("pictures", True),
+        obstacles=obstacles,
     )
+
+
+def _obstacles(path: Path, data: dict[str, Any], dimension: int) -> tuple[ObstacleContactSpec, ...]:
+    """[obstacle] with [contact] (one, named "obstacle"), or [[obstacle]] blocks (several).
+
+    A block holds the obstacle's keys and its contact's (tag or detect, r,
+    relative, quadrature, mu, tangential_r_max) and an optional name.
+    """
+    if not isinstance(data.get("obstacle"), list):
+        obstacle = _obstacle(_table(path, data, "obstacle"), dimension)
+        return (_checked_entry(path, ObstacleContactSpec(
+            "obstacle", obstacle, _contact(_table(path, data, "contact")))),)
+    blocks = data["obstacle"]
+    if not blocks or not all(isinstance(t, dict) for t in blocks):
+        raise SceneError(f"{path.name}: [obstacle] must be a table or [[obstacle]] blocks "
+                         f"(tables), not {blocks!r}.")
+    if "contact" in data:
+        raise SceneError(
+            f"{path.name}: [contact] goes with a single [obstacle]; with [[obstacle]] blocks "
+            "give each block its own contact keys (tag, r, mu, ...) and remove [contact]."
+        )
+    out = []
+    for i, table in enumerate(blocks):
+        _check_keys(path, "obstacles", table)
+        name = table.get("name", f"obstacle{i + 1}")
+        if not isinstance(name, str) or not name:
+            raise SceneError(f"{path.name}: [[obstacle]] {i + 1} name = {name!r}: give a word.")
+        reader = _Reader(path, f"obstacle '{name}'", table)
+        out.append(_checked_entry(path, ObstacleContactSpec(
+            name, _obstacle(reader, dimension), _contact(reader))))
+    names = [o.name for o in out]
+    if len(set(names)) != len(names):
+        raise SceneError(f"{path.name}: [[obstacle]] names {names} repeat; name each once.")
+    return tuple(out)
+
+
+def _checked_entry(path: Path, entry: ObstacleContactSpec) -> ObstacleContactSpec:
+    if entry.obstacle.schedule and entry.contact.detect:
+        where = "[contact]" if entry.name == "obstacle" else f"[obstacle '{entry.name}']"
+        raise SceneError(
+            f"{path.name}: {where} detect = true follows the obstacle's straight motion; "
+            f"with a schedule give the candidate facets by tag."
+        )
+    return entry
 
 
 def _fields(output: _Reader, mu: float | None, section: str) -> tuple[str, ...]:
@@ -495,6 +540,7 @@ __all__ = [
     "BoundarySpec",
     "ContactSpec",
     "MeshSpec",
+    "ObstacleContactSpec",
     "ObstacleSpec",
     "PairSpec",
     "Scene",

@@ -8,7 +8,7 @@ them. Units are the user's (be consistent); sign conventions are those of
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from fenics_contact.model.contact import ContactSettings
@@ -113,6 +113,15 @@ class ContactSpec(ContactSettings):
 
 
 @dataclass(frozen=True)
+class ObstacleContactSpec:
+    """One rigid obstacle and the contact of the body's facets with it."""
+
+    name: str
+    obstacle: ObstacleSpec
+    contact: ContactSpec
+
+
+@dataclass(frozen=True)
 class SolverSpec(SolverSettings):
     """Stopping rules (:class:`SolverSettings`) plus strategy and load stepping."""
 
@@ -145,8 +154,36 @@ class Scene:
     description: str = ""
     bodies: tuple[BodySpec, ...] = ()
     pairs: tuple[PairSpec, ...] = ()
+    #: Every rigid obstacle with its contact ([obstacle] and [contact]: one
+    #: named "obstacle"; [[obstacle]] blocks: one each). ``obstacle`` and
+    #: ``contact`` are the first one's.
+    obstacles: tuple[ObstacleContactSpec, ...] = ()
+
+    def __post_init__(self) -> None:
+        """Keep ``obstacles`` and the first obstacle's fields one description.
+
+        With one obstacle, ``obstacle`` and ``contact`` are the source (a
+        ``dataclasses.replace`` of either is seen by ``obstacles``); with
+        several, ``obstacles`` is the source and the two fields follow its
+        first entry.
+        """
+        if self.obstacle.type == "none":  # deformable pairs only
+            return
+        first = ObstacleContactSpec("obstacle", self.obstacle, self.contact)
+        if len(self.obstacles) <= 1:
+            name = self.obstacles[0].name if self.obstacles else "obstacle"
+            object.__setattr__(self, "obstacles", (replace(first, name=name),))
+        else:
+            object.__setattr__(self, "obstacle", self.obstacles[0].obstacle)
+            object.__setattr__(self, "contact", self.obstacles[0].contact)
 
     @property
     def two_body(self) -> bool:
         """True when the scene declares deformable bodies and contact pairs."""
         return bool(self.pairs)
+
+    @property
+    def frictional(self) -> bool:
+        """True when some contact (obstacle or pair) has a Coulomb coefficient mu."""
+        return any(o.contact.mu is not None for o in self.obstacles) or any(
+            p.mu is not None for p in self.pairs)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from fenics_contact.model.problem import ContactProblem
 from fenics_contact.solvers.auto import AutoStrategy
 from fenics_contact.solvers.base import Observer, SolveResult, Strategy
@@ -51,7 +53,8 @@ def make_strategy(
         problem: the problem it solves (its current state is the start).
         settings: stopping rules.
         linear: linear solver of every Newton kernel the strategy uses
-            (direct MUMPS when None).
+            (direct MUMPS when None). Where contacts share nodes, null-pivot
+            detection is switched on (see :class:`LinearSolverSettings`).
         observer: called with (iterations, residual) at every residual check.
         predictor: 'previous' starts each load step from the last converged
             state; 'extrapolate' from the linear extrapolation of the last two.
@@ -64,6 +67,8 @@ def make_strategy(
         ) from None
     if predictor not in PREDICTORS:
         raise ValueError(f"Unknown predictor {predictor!r}; choose one of {', '.join(PREDICTORS)}.")
+    if problem.shared_contact_nodes:  # contacts meet at nodes: equal rows are possible
+        linear = replace(linear or LinearSolverSettings(), null_pivots=True)
     strategy: Strategy = cls(problem, settings, linear=linear, observer=observer)
     return Extrapolated(strategy) if predictor == "extrapolate" else strategy
 

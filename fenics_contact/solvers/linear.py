@@ -47,6 +47,13 @@ class LinearSolverSettings:
         amg_smooth_its: GAMG smoothing sweeps per level.
         reuse_interpolation: keep the GAMG prolongators between Newton steps
             (only the Galerkin products are recomputed).
+        null_pivots: let MUMPS set aside pivots that are zero to round-off
+            (its threshold, 1e-5 eps ||A||) and solve the consistent singular
+            system. For contacts that share nodes: a corner pressed on a floor
+            and sticking to a wall is held twice in one direction, two
+            constraint rows are equal and only their sum is determined. Off
+            by default, so that a singular problem (a body nothing holds)
+            fails as such.
     """
 
     kind: LinearKind = "direct"
@@ -59,6 +66,7 @@ class LinearSolverSettings:
     amg_threshold: float = 0.02
     amg_smooth_its: int = 2
     reuse_interpolation: bool = True
+    null_pivots: bool = False
 
     def __post_init__(self) -> None:
         if self.kind not in ("direct", "iterative"):
@@ -169,6 +177,8 @@ def configure_ksp(
         ksp.setType("preonly")
         pc.setType("lu")
         pc.setFactorSolverType(settings.factor)
+        if settings.null_pivots and settings.factor == "mumps":
+            _set_options(prefix, {"mat_mumps_icntl_24": 1})
         ksp.setFromOptions()
         return ()
     ksp.setType("gmres")

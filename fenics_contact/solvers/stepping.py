@@ -24,6 +24,7 @@ import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 
+from fenics_contact.model.state import combined_state
 from fenics_contact.solvers.base import SolveResult, Strategy
 from fenics_contact.solvers.diagnostics import Status
 
@@ -53,6 +54,9 @@ class StepRecord:
             (force, per thickness in 2D; 0 without friction).
         stick_count: contact nodes that stick (0 without friction).
         slip_count: contact nodes that slip (0 without friction).
+        contacts: each contact's numbers by name (normal_force, active_count,
+            max_penetration, tangential_force, stick_count, slip_count); the
+            fields above are their sums (the largest penetration).
     """
 
     step: int
@@ -73,6 +77,7 @@ class StepRecord:
     tangential_force: float = 0.0
     stick_count: int = 0
     slip_count: int = 0
+    contacts: dict[str, dict] = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """Plain-data view for JSON."""
@@ -302,7 +307,9 @@ def solve_load_path(
             increment /= 2
             step.cutbacks += 1
         step.wall_s = time.perf_counter() - start
-        state = problem.contact_state()
+        states = problem.contact_states()
+        state = combined_state(list(states.values()))
+        step.contacts = {name: s.summary() for name, s in states.items()}
         step.active_count = state.active_count
         step.max_penetration = state.max_penetration
         step.contact_force = state.contact_force

@@ -251,6 +251,8 @@ class StrikerOnFacetProblem:
 
     #: The point measure sits at the striker node.
     nodal_rule = True
+    #: One contact: no node is shared between contacts.
+    shared_contact_nodes = 0
     name = "striker"
 
     @property
@@ -371,6 +373,10 @@ class StrikerOnFacetProblem:
         return ContactState.gathered(
             self.comm, gap, pressure, self.lam.x.array[: gap.size].copy(), float(-pressure.sum())
         )
+
+    def contact_states(self) -> dict[str, ContactState]:
+        """The one contact's state by name."""
+        return {self.name: self.contact_state()}
 
     def active_signature(self) -> tuple[bytes, ...]:
         """Whether the striker transmits a force (lam + r g < 0), gathered over ranks."""
