@@ -195,3 +195,65 @@ def test_the_shipped_scene_gives_the_serial_forces_on_any_number_of_processes(tm
     assert last["wall"]["tangential_force"] == pytest.approx(
         0.2 * last["wall"]["normal_force"], rel=1e-8)
     assert (last["floor"]["active_count"], last["wall"]["active_count"]) == (17, 14)
+
+
+SQUEEZED = """
+[scene]
+name = "squeezed"
+dimension = 2
+
+[mesh]
+generator = "rectangle"
+size = [1.0, 1.0]
+cells = [6, 6]
+
+[material]
+law = "linear"
+E = 210.0
+nu = 0.3
+
+[[dirichlet]]
+tag = "left"
+value = [0.0, "free"]
+
+[[obstacle]]
+name = "floor"
+type = "plane"
+point = [0.0, 0.0]
+normal = [0.0, 1.0]
+tag = "bottom"
+
+[[obstacle]]
+name = "plate"
+type = "plane"
+point = [0.0, 1.0]
+normal = [0.0, -1.0]
+motion = [0.0, -0.01]
+tag = "top"
+r = 100.0
+
+[solver]
+steps = 4
+"""
+
+
+def test_a_body_held_only_by_the_plates_it_touches_is_accepted_and_exact(tmp_path):
+    """Nothing but the two plates holds the block vertically: each closes when it moves."""
+    outcome = run_scene(load_scene(write(tmp_path, SQUEEZED)), tmp_path / "out",
+                        comm=MPI.COMM_SELF, pictures=False)
+    assert outcome.path.converged
+    exact = 210.0 / (1 - 0.3**2) * 0.01
+    for name, state in outcome.problem.contact_states().items():
+        assert state.contact_force == pytest.approx(exact, rel=1e-9), name
+        assert np.allclose(state.pressure, -exact, rtol=1e-9), name
+
+
+def test_a_body_that_one_plate_touches_is_refused(tmp_path):
+    """Without the floor the plate pushes the block away: nothing holds it."""
+    text = SQUEEZED[:SQUEEZED.index('[[obstacle]]\nname = "floor"')] + SQUEEZED[
+        SQUEEZED.index('[[obstacle]]\nname = "plate"'):]
+    from fenics_contact.scene.build import build_problem
+
+    with pytest.raises(SceneError, match=r"leave rigid motions of the body free \(translation "
+                       r"in y\); contact does not hold them"):
+        build_problem(load_scene(write(tmp_path, text)), MPI.COMM_SELF)

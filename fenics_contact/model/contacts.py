@@ -109,6 +109,8 @@ class Contact:
 
     #: E of the r scale (stress); set by :meth:`_bind_partner`.
     modulus: float
+    #: The node-to-segment search of a deformable pair; None against a rigid obstacle.
+    pair = None
 
     # -- parameters and loads ----------------------------------------------------------
     @property

@@ -15,7 +15,7 @@ its size so that translations and rotations weigh alike.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 from dolfinx import mesh
@@ -138,3 +138,107 @@ def _describe(mode: np.ndarray, centre: np.ndarray, size: float, gdim: int) -> s
     # a = -w x c (+ a screw part along w); c = (w x a) / |w|^2 is the nearest axis point
     c = np.cross(w, a) / np.dot(w, w) * size + centre
     return f"rotation about the axis ({_fmt(axis)}) through ({_fmt(c)})"
+
+
+def assembly_held(
+    domain: mesh.Mesh,
+    bodies: Sequence[tuple[str, np.ndarray]],
+    conditions: Sequence[tuple[np.ndarray, Sequence[float | None]]],
+    contact_gaps: Callable[[np.ndarray], np.ndarray],
+) -> bool:
+    """Whether the Dirichlet conditions and the contacts closed at the start hold every body.
+
+    Each body may move rigidly on its own. A Dirichlet component holds the
+    body whose facets carry it both ways. A contact node whose gap is zero
+    at the start resists only the motions that close it (the gap is
+    unilateral): a free motion is one that the conditions allow and that
+    closes no closed contact node, found by linear programs over the rigid
+    modes the conditions leave free. The gap's change along each rigid mode
+    is measured (a difference quotient), so rigid obstacles and deformable
+    pairs count alike; a frictionless contact holds nothing along it.
+
+    Args:
+        domain: the mesh of every body.
+        bodies: (name, local cell indices) of each body.
+        conditions: (local facet indices, value per component, None free) of
+            each Dirichlet condition.
+        contact_gaps: the owned nodal gaps of every contact (joined) for a
+            displacement given per geometry node, shape (nodes, gdim) (length).
+
+    Returns:
+        True when no rigid motion of the assembly is free. Collective.
+    """
+    from scipy.optimize import linprog
+
+    gdim = domain.geometry.dim
+    tdim = domain.topology.dim
+    comm = domain.comm
+    x = domain.geometry.x[:, :gdim]
+    lo, hi = _reduce(comm, x, np.min, MPI.MIN), _reduce(comm, x, np.max, MPI.MAX)
+    centre = 0.5 * (lo + hi)
+    size = float(np.max(hi - lo)) or 1.0
+    n_modes = 3 if gdim == 2 else 6
+    n = n_modes * len(bodies)
+    gram = np.zeros((n, n))
+    vertices = []
+    for i, (_, cells) in enumerate(bodies):
+        verts = np.unique(mesh.entities_to_geometry(domain, tdim, cells.astype(np.int32)).ravel())
+        vertices.append(verts)
+        on_body = np.zeros(x.shape[0], bool)
+        on_body[verts] = True
+        for facets, value in conditions:
+            facets = np.asarray(facets, dtype=np.int32)
+            if facets.size == 0:
+                continue
+            fverts = np.unique(mesh.entities_to_geometry(domain, tdim - 1, facets).ravel())
+            points = (x[fverts[on_body[fverts]]] - centre) / size
+            for component, v in enumerate(value):
+                if v is not None and points.size:
+                    rows = np.zeros((points.shape[0], n))
+                    rows[:, i * n_modes:(i + 1) * n_modes] = _basis(points, component, gdim)
+                    gram += rows.T @ rows
+    total = np.empty_like(gram)
+    comm.Allreduce(gram, total, op=MPI.SUM)
+    eigenvalues, vectors = np.linalg.eigh(total)
+    free = vectors[:, eigenvalues <= 1e-10 * max(float(eigenvalues.max()), 1.0)]
+    if free.shape[1] == 0:
+        return True
+    # d gap / d mode at the closed nodes, for the modes the conditions leave free
+    step = 1e-7 * size
+    base = contact_gaps(np.zeros_like(x))
+    closed = base <= 1e-9 * size
+    columns = []
+    for j in range(free.shape[1]):
+        u = np.zeros_like(x)
+        for i in range(len(bodies)):
+            points = (x[vertices[i]] - centre) / size
+            mode = free[i * n_modes:(i + 1) * n_modes, j]
+            u[vertices[i]] += np.column_stack(
+                [_basis(points, c, gdim) @ mode for c in range(gdim)]) * step
+        columns.append((contact_gaps(u) - base)[closed] / step)
+    local = np.column_stack(columns) if columns else np.zeros((0, free.shape[1]))
+    resist = np.vstack(comm.allgather(local))
+    # a free motion: resist c >= 0 (no closed node penetrates), c != 0; look along each axis
+    k = free.shape[1]
+    for j in range(k):
+        for sign in (1.0, -1.0):
+            objective = np.zeros(k)
+            objective[j] = -sign
+            # a closing rate below 1e-9 (scaled) is the difference quotient's noise;
+            # a free motion reaches the bounds (+-1), a held one stays near 0
+            result = linprog(objective, A_ub=-resist if resist.size else None,
+                             b_ub=np.full(resist.shape[0], 1e-9) if resist.size else None,
+                             bounds=[(-1.0, 1.0)] * k, method="highs")
+            if result.status == 0 and -result.fun > 1e-3:
+                return False
+    return True
+
+
+def _reduce(comm: MPI.Comm, x: np.ndarray, local: Callable, op: MPI.Op) -> np.ndarray:
+    """Per-axis min or max of the coordinates over the ranks."""
+    gdim = x.shape[1]
+    fill = np.inf if op == MPI.MIN else -np.inf
+    mine = local(x, axis=0) if x.size else np.full(gdim, fill)
+    out = np.empty(gdim)
+    comm.Allreduce(np.ascontiguousarray(mine, dtype=float), out, op=op)
+    return out

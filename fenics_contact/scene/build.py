@@ -9,6 +9,7 @@ before any form is compiled.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -22,6 +23,7 @@ from fenics_contact.model.friction import FrictionSettings
 from fenics_contact.model.materials import material
 from fenics_contact.model.obstacle_contact import ObstacleContact
 from fenics_contact.model.obstacles import RigidBall, RigidObstacle, RigidPlane
+from fenics_contact.model.pairs import NodeToSegmentContact
 from fenics_contact.model.problem import (
     Body,
     ContactProblem,
@@ -29,7 +31,6 @@ from fenics_contact.model.problem import (
     PrescribedDisplacement,
     Solid,
     SurfaceTraction,
-    two_body_problem,
 )
 from fenics_contact.model.rigid import free_rigid_motions
 from fenics_contact.scene.checks import (
@@ -38,6 +39,8 @@ from fenics_contact.scene.checks import (
     check_cells,
     check_initial_overlap,
     check_pair_surfaces,
+    facet_owners,
+    held_by_closed_contacts,
 )
 from fenics_contact.scene.meshing import mesh_on_rank, open_geo
 from fenics_contact.scene.schema import (
@@ -250,16 +253,34 @@ def contact_facets(
     )
 
 
-def obstacle_contact(scene: Scene, body: BodyMesh, entry: ObstacleContactSpec) -> ObstacleContact:
-    """One [[obstacle]] (or [obstacle] with [contact]) as a contact of the body."""
+def obstacle_contact(
+    scene: Scene, body: BodyMesh, entry: ObstacleContactSpec, bodies: Sequence[Body] = ()
+) -> ObstacleContact:
+    """One [[obstacle]] (or [obstacle] with [contact]) as a contact of the body.
+
+    With several ``bodies`` the body that carries the facets sets the r scale
+    E/h; facets on no single body are refused.
+    """
     obstacle = build_obstacle(entry.obstacle, body.domain)
     spec = entry.contact
+    facets = contact_facets(scene, body, entry, obstacle)
+    owner = None
+    if bodies:
+        assert body.cell_tags is not None
+        owners = facet_owners(body.domain, body.cell_tags, bodies, facets)
+        if len(owners) != 1:
+            raise SceneError(
+                f"{scene.path.name}: [{_contact_section(entry)}] tag = {spec.tag!r} lies on "
+                f"{'no body' if not owners else 'bodies ' + ', '.join(map(repr, owners))}; "
+                "give an obstacle the facets of one body (one [[obstacle]] per body)."
+            )
+        owner = owners[0]
     friction = None if spec.mu is None else FrictionSettings(spec.mu, spec.tangential_r_max)
     return ObstacleContact(
-        obstacle, contact_facets(scene, body, entry, obstacle),
+        obstacle, facets,
         spec,  # a ContactSettings with the candidate and friction keys
         motion=entry.obstacle.motion, schedule=entry.obstacle.schedule or None,
-        friction=friction, name=entry.name,
+        friction=friction, body=owner, name=entry.name,
     )
 
 
@@ -293,7 +314,7 @@ def boundary_conditions(
 
 
 def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
-    """Bodies, conditions and the contact pair of a two-body scene (with [[pair]] mu: friction)."""
+    """Bodies, conditions, every contact pair and every obstacle of a scene with [[body]] blocks."""
     comm = body.domain.comm
     if body.cell_tags is None:
         raise SceneError(
@@ -311,20 +332,24 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
                 f"the mesh; available: {named or ', '.join(map(str, present))}."
             )
         bodies.append(Body(spec.name, tag, material(spec.law, spec.E, spec.nu)))
-    pair = scene.pairs[0]
     prescribed, tractions = boundary_conditions(scene, body)
-    striker = tagged_facets(body, scene, "pair striker", pair.striker)
-    target = tagged_facets(body, scene, "pair target", pair.target)
-    check_pair_surfaces(scene, body.domain, body.cell_tags, bodies, striker, target)
-    check_bodies_held(scene, body.domain, body.cell_tags, bodies, prescribed)
-    friction = (None if pair.mu is None
-                else FrictionSettings(pair.mu, pair.tangential_r_max))
-    problem = two_body_problem(
-        body.domain, body.cell_tags, bodies, striker, target,
-        ContactSettings(r=pair.r, relative=pair.relative),
-        prescribed=prescribed, tractions=tractions, friction=friction, name=pair.name,
-    )
+    contacts: list = []
+    for pair in scene.pairs:
+        striker = tagged_facets(body, scene, "pair striker", pair.striker)
+        target = tagged_facets(body, scene, "pair target", pair.target)
+        check_pair_surfaces(scene, body.domain, body.cell_tags, bodies, striker, target, pair)
+        friction = (None if pair.mu is None
+                    else FrictionSettings(pair.mu, pair.tangential_r_max))
+        contacts.append(NodeToSegmentContact(
+            striker, target, ContactSettings(r=pair.r, relative=pair.relative),
+            friction=friction, name=pair.name))
+    contacts += [obstacle_contact(scene, body, entry, bodies) for entry in scene.obstacles]
+    solid = Solid(body.domain, bodies, body.cell_tags, prescribed=prescribed,
+                  tractions=tractions)
+    problem = ContactProblem(solid, contacts)
+    check_bodies_held(scene, problem, body.cell_tags, bodies, prescribed)
     check_initial_overlap(scene, problem)
+    warn_initial_penetration(scene, problem)
     return problem
 
 
@@ -340,25 +365,30 @@ def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProbl
             f"{body.domain.geometry.dim}D."
         )
     prescribed, tractions = boundary_conditions(scene, body)
-    check_rigid_motions(scene, body, prescribed)
+    free = free_rigid_motions(body.domain, [(p.facets, p.at(1.0)) for p in prescribed])
     solid = Solid(body.domain, [Body("body", None, material(scene.law, scene.E, scene.nu))],
                   prescribed=prescribed, tractions=tractions)
     contacts = [obstacle_contact(scene, body, entry) for entry in scene.obstacles]
     problem = ContactProblem(solid, contacts)
+    check_rigid_motions(scene, problem, free, prescribed)
     warn_initial_penetration(scene, problem)
     return problem
 
 
 def check_rigid_motions(
-    scene: Scene, body: BodyMesh, prescribed: list[PrescribedDisplacement]
+    scene: Scene, problem: ContactProblem, free: list[str],
+    prescribed: list[PrescribedDisplacement],
 ) -> None:
-    """Raise SceneError naming the rigid motions no Dirichlet condition holds.
+    """Raise SceneError naming the rigid motions (``free``) no Dirichlet condition holds.
 
-    Contact and tractions do not count: before contact is made they hold
-    nothing and the stiffness is singular.
+    Tractions do not count, nor contacts that are open at the start: before
+    contact is made they hold nothing and the stiffness is singular. Contacts
+    closed at the start hold the motions that would close them (a block
+    squeezed between two plates it touches).
     """
-    free = free_rigid_motions(body.domain, [(p.facets, p.at(1.0)) for p in prescribed])
-    if free:
+    cells = np.arange(problem.domain.topology.index_map(problem.domain.topology.dim).size_local,
+                      dtype=np.int32)
+    if free and not held_by_closed_contacts(problem, [("body", cells)], prescribed):
         raise SceneError(
             f"{scene.path.name}: the [[dirichlet]] conditions leave rigid motions of the body "
             f"free ({'; '.join(free)}); contact does not hold them. Fix: prescribe more "
@@ -380,13 +410,14 @@ def warn_initial_penetration(scene: Scene, problem: ContactProblem) -> float:
     Returns the largest initial depth over the obstacles (length).
     """
     deepest = 0.0
-    for contact in problem.contacts:
+    obstacles = [c for c in problem.contacts if isinstance(c, ObstacleContact)]
+    for contact in obstacles:
         depth = initial_penetration(contact)
         deepest = max(deepest, depth)
         h = contact.surface.h
         if depth <= h:
             continue
-        which = "the obstacle" if len(problem.contacts) == 1 else f"obstacle '{contact.name}'"
+        which = "the obstacle" if len(obstacles) == 1 else f"obstacle '{contact.name}'"
         warnings.warn(
             SceneWarning(
                 f"{scene.path.name}: the body starts {depth:.4g} inside {which}, more "

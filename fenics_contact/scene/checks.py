@@ -18,8 +18,8 @@ from dolfinx import mesh
 from mpi4py import MPI
 
 from fenics_contact.model.problem import PrescribedDisplacement
-from fenics_contact.model.rigid import free_rigid_motions
-from fenics_contact.scene.schema import Scene, SceneError
+from fenics_contact.model.rigid import assembly_held, free_rigid_motions
+from fenics_contact.scene.schema import PairSpec, Scene, SceneError
 
 if TYPE_CHECKING:
     from fenics_contact.model.body import Body
@@ -118,6 +118,16 @@ def _facets_on(domain: mesh.Mesh, marker: np.ndarray, facets: np.ndarray) -> np.
     return np.array([f for f in facets if marker[f2c.links(int(f))].any()], dtype=np.int32)
 
 
+def facet_owners(domain: mesh.Mesh, cell_tags: mesh.MeshTags, bodies: Sequence[Body],
+                 facets: np.ndarray) -> list[str]:
+    """Names of the bodies whose cells carry some of the facets (collective)."""
+    return [
+        b.name for b in bodies
+        if domain.comm.allreduce(
+            _facets_on(domain, _body_cells(domain, cell_tags, b.tag), facets).size, op=MPI.SUM)
+    ]
+
+
 def check_pair_surfaces(
     scene: Scene,
     domain: mesh.Mesh,
@@ -125,13 +135,13 @@ def check_pair_surfaces(
     bodies: Sequence[Body],
     striker: np.ndarray,
     target: np.ndarray,
+    pair: PairSpec,
 ) -> None:
     """Striker and target lie on the boundary, each on one body, and on two different bodies."""
     comm = domain.comm
     tdim = domain.topology.dim
     domain.topology.create_connectivity(tdim - 1, tdim)
     exterior = mesh.exterior_facet_indices(domain.topology)
-    pair = scene.pairs[0]
     owners: dict[str, list[str]] = {}
     for role, facets, tag in (("striker", striker, pair.striker), ("target", target, pair.target)):
         inner = comm.allreduce(int(np.setdiff1d(facets, exterior).size), op=MPI.SUM)
@@ -142,13 +152,7 @@ def check_pair_surfaces(
                 "bodies apart (in a .geo: Geometry.AutoCoherence = 0, or separate surfaces) "
                 "so each contact surface is a boundary."
             )
-        owners[role] = [
-            b.name for b in bodies
-            if comm.allreduce(
-                _facets_on(domain, _body_cells(domain, cell_tags, b.tag), facets).size,
-                op=MPI.SUM,
-            )
-        ]
+        owners[role] = facet_owners(domain, cell_tags, bodies, facets)
     if owners["striker"] == owners["target"] and len(owners["striker"]) == 1:
         raise SceneError(
             f"{scene.path.name}: [[pair]] striker = {pair.striker!r} and target = "
@@ -159,47 +163,97 @@ def check_pair_surfaces(
 
 def check_bodies_held(
     scene: Scene,
-    domain: mesh.Mesh,
+    problem: ContactProblem,
     cell_tags: mesh.MeshTags,
     bodies: Sequence[Body],
     prescribed: Sequence[PrescribedDisplacement],
 ) -> None:
-    """Every body's rigid motions are held by its own Dirichlet conditions (not by contact)."""
+    """Every body's rigid motions are held, by Dirichlet conditions or closed contacts.
+
+    A contact closed at the start holds the motions that would close it (a
+    block in a stack); one open at the start holds nothing.
+    """
+    domain = problem.domain
+    free = []
     for body in bodies:
         marker = _body_cells(domain, cell_tags, body.tag)
         own = [(_facets_on(domain, marker, p.facets), p.at(1.0)) for p in prescribed]
-        free = free_rigid_motions(domain, own)
-        if free:
-            raise SceneError(
-                f"{scene.path.name}: [[body]] {body.name!r}: no [[dirichlet]] condition holds "
-                f"its rigid motions ({'; '.join(free)}), and contact holds nothing before it "
-                f"closes. Fix: prescribe components on a face of {body.name!r} (e.g. a "
-                "support, a symmetry plane or a driven face)."
-            )
+        motions = free_rigid_motions(domain, own)
+        if motions:
+            free.append((body.name, motions))
+    if not free:
+        return
+    cells = [(b.name, cell_tags.find(b.tag)) for b in bodies]
+    if held_by_closed_contacts(problem, cells, prescribed):
+        return
+    name, motions = free[0]
+    raise SceneError(
+        f"{scene.path.name}: [[body]] {name!r}: no [[dirichlet]] condition holds "
+        f"its rigid motions ({'; '.join(motions)}), and contact holds nothing before it "
+        f"closes (nor along it, frictionless). Fix: prescribe components on a face of "
+        f"{name!r} (e.g. a support, a symmetry plane or a driven face), or start it "
+        "touching the parts that hold it."
+    )
+
+
+def held_by_closed_contacts(
+    problem: ContactProblem,
+    bodies: Sequence[tuple[str, np.ndarray]],
+    prescribed: Sequence[PrescribedDisplacement],
+) -> bool:
+    """Whether the conditions and the contacts closed at load 0 hold every body (see rigid.py).
+
+    Evaluates each contact's gaps for rigid motions of the bodies (u is put
+    back to zero afterwards). Collective.
+    """
+    domain, V, u = problem.domain, problem.V, problem.u
+    gdim = domain.geometry.dim
+    nodes = domain.geometry.dofmaps[0]
+    block = np.full(domain.geometry.x.shape[0], -1, dtype=np.int64)
+    block[nodes[:, : V.dofmap.list.shape[1]].reshape(-1)] = V.dofmap.list.reshape(-1)
+    mapped = block >= 0
+
+    def gaps(displacement: np.ndarray) -> np.ndarray:
+        u.x.array.reshape(-1, gdim)[block[mapped]] = displacement[mapped]
+        return np.concatenate([c.contact_state().gap for c in problem.contacts])
+
+    try:
+        return assembly_held(domain, bodies, [(p.facets, p.at(1.0)) for p in prescribed], gaps)
+    finally:
+        u.x.array[:] = 0.0
+        problem.refresh_search()
 
 
 def check_initial_overlap(scene: Scene, problem: ContactProblem) -> float:
     """Refuse bodies that start inside each other deeper than the striker facet size h.
 
-    Only striker nodes whose projection falls on a target facet count. A
-    shallower overlap is resolved by the first step and reported as a
-    :class:`SceneWarning`. Returns the depth (length).
+    Only striker nodes whose projection falls on a target facet count, over
+    every deformable pair. A shallower overlap is resolved by the first step
+    and reported as a :class:`SceneWarning`. Returns the largest depth (length).
     """
-    comm = problem.comm
-    state = problem.contact_state()
+    deepest = 0.0
+    for contact in problem.contacts:
+        if contact.pair is not None:
+            deepest = max(deepest, _pair_overlap(scene, contact))
+    return deepest
+
+
+def _pair_overlap(scene: Scene, contact) -> float:
+    comm = contact.comm
+    state = contact.contact_state()
     n = state.gap.size
-    on_facet = problem.pair.projection.overshoot[:n] <= 1e-12
+    on_facet = contact.pair.projection.overshoot[:n] <= 1e-12
     depth = np.where(on_facet, -state.gap, 0.0)
     worst = int(np.argmax(depth)) if n else None
     found = _first_on_any_rank(
         comm,
         None if worst is None or depth[worst] <= 0.0
-        else (-float(depth[worst]), problem.nodal_coordinates()[worst]),
+        else (-float(depth[worst]), contact.nodal_coordinates()[worst]),
     )
     if found is None:
         return 0.0
-    deepest, where = -found[0], _where(found[1], problem.domain.geometry.dim)
-    h = problem.surface.h
+    deepest, where = -found[0], _where(found[1], contact.gdim)
+    h = contact.surface.h
     if deepest > h:
         raise SceneError(
             f"{scene.path.name}: the bodies start {deepest:.4g} inside each other near {where}, "

@@ -30,9 +30,11 @@ Layout (units are the user's; be consistent)::
                  block holds one obstacle's keys, its contact's keys (tag or
                  detect, r, relative, quadrature, mu, tangential_r_max) and
                  a name (default obstacle1, obstacle2, ...)
-    [[body]]     name, tag (cell tag), law, E, nu      } two deformable bodies
-    [[pair]]     striker, target (facet tags), r,     } instead of [material],
-                 relative, mu, tangential_r_max       } [obstacle], [contact]
+    [[body]]     name, tag (cell tag), law, E, nu      } deformable bodies
+    [[pair]]     name, striker, target (facet tags),  } instead of [material]
+                 r, relative, mu, tangential_r_max    } and [contact]; any
+                                                      } number of pairs and
+                                                      } of [[obstacle]] blocks
     [solver]     method, steps, max_iterations, atol, rtol, max_cutbacks,
                  predictor = "extrapolate" (start a step from the linear
                  extrapolation of the last two) | "previous",
@@ -40,12 +42,12 @@ Layout (units are the user's; be consistent)::
                  Schur field split, algebraic multigrid; for large 3D)
     [output]     fields = [...], pictures = true
 
-Two deformable bodies in one mesh replace [material], [obstacle] and
-[contact] by::
+Deformable bodies in one mesh replace [material] and [contact] by::
 
     [[body]]     name, tag (cell tag), law, E, nu      (one per body)
-    [[pair]]     striker, target (facet tags), r, relative,
+    [[pair]]     name, striker, target (facet tags), r, relative,
                  mu, tangential_r_max (Coulomb friction, as in [contact])
+    [[obstacle]] as above, its tag on the facets of one body
 
 In every scene a [[dirichlet]] may give path = [[t, ux, uy], ...] (a
 piecewise-linear displacement against the load factor, every component
@@ -241,9 +243,6 @@ def _pairs(path: Path, data: dict[str, Any]) -> tuple[PairSpec, ...]:
             mu=_friction(reader),
             tangential_r_max=reader.number("tangential_r_max", 2.0, positive=True),
         ))
-    if len(out) > 1:
-        raise SceneError(f"{path.name}: {len(out)} [[pair]] blocks; one contact pair per scene "
-                         "is supported so far: keep one.")
     return tuple(out)
 
 
@@ -433,6 +432,14 @@ def _obstacles(path: Path, data: dict[str, Any], dimension: int) -> tuple[Obstac
         obstacle = _obstacle(_table(path, data, "obstacle"), dimension)
         return (_checked_entry(path, ObstacleContactSpec(
             "obstacle", obstacle, _contact(_table(path, data, "contact")))),)
+    return _obstacle_blocks(path, data, dimension)
+
+
+def _obstacle_blocks(path: Path, data: dict[str, Any], dimension: int
+                     ) -> tuple[ObstacleContactSpec, ...]:
+    """The [[obstacle]] blocks (none when the scene has none)."""
+    if "obstacle" not in data:
+        return ()
     blocks = data["obstacle"]
     if not blocks or not all(isinstance(t, dict) for t in blocks):
         raise SceneError(f"{path.name}: [obstacle] must be a table or [[obstacle]] blocks "
@@ -488,24 +495,40 @@ def _elastic_constants(material: _Reader) -> tuple[float, float]:
 
 
 def _two_body_scene(path: Path, data: dict[str, Any], head: _Reader, dimension: int) -> Scene:
-    """A scene of deformable bodies ([[body]]) and contact pairs ([[pair]])."""
-    for key in ("material", "obstacle", "contact"):
+    """A scene of deformable bodies ([[body]]), contact pairs ([[pair]]) and obstacles.
+
+    Any number of pairs and of [[obstacle]] blocks (each naming the facets of
+    a body that may touch it).
+    """
+    for key in ("material", "contact"):
         if key in data:
             raise SceneError(
                 f"{path.name}: [{key}] belongs to single-body scenes; with [[body]] and "
-                "[[pair]] give each body its law in [[body]] and r in [[pair]]."
+                "[[pair]] give each body its law in [[body]] and r in [[pair]] or [[obstacle]]."
             )
+    if "obstacle" in data and not isinstance(data["obstacle"], list):
+        raise SceneError(
+            f"{path.name}: with [[body]] blocks give rigid obstacles as [[obstacle]] blocks, "
+            "each with the facet tag that may touch it (tag) and its r and mu."
+        )
     bodies = _bodies(path, data)
     pairs = _pairs(path, data)
+    obstacles = _obstacle_blocks(path, data, dimension)
     if len(bodies) < 2:
         raise SceneError(f"{path.name}: {len(bodies)} [[body]] block(s); a contact pair needs "
                          "two bodies: add a [[body]] per body (name, tag, law, E, nu).")
     if not pairs:
         raise SceneError(f"{path.name}: no [[pair]] block; add one with striker and target "
                          "facet tags.")
+    names = [p.name for p in pairs] + [o.name for o in obstacles]
+    if len(set(names)) != len(names):
+        raise SceneError(f"{path.name}: contact names {names} repeat; give each [[pair]] and "
+                         "[[obstacle]] its own name.")
     pair = pairs[0]
     output = _table(path, data, "output", required=False)
-    fields = _fields(output, pair.mu, "[[pair]]")
+    mu = next((m for m in [p.mu for p in pairs] + [o.contact.mu for o in obstacles]
+               if m is not None), None)
+    fields = _fields(output, mu, "[[pair]] or [[obstacle]]")
     return Scene(
         path=path,
         name=str(head.table.get("name", path.stem)),
@@ -525,6 +548,7 @@ def _two_body_scene(path: Path, data: dict[str, Any], head: _Reader, dimension: 
         pictures=output.flag("pictures", True),
         bodies=bodies,
         pairs=pairs,
+        obstacles=obstacles,
     )
 
 
