@@ -42,7 +42,7 @@ from fenics_contact.model.problem import (
 )
 from fenics_contact.runner import run_scene
 from fenics_contact.scene.build import build_problem
-from fenics_contact.scene.schema import Scene, SceneError, load_scene
+from fenics_contact.scene.schema import Scene, SceneError, load_scene, scene_from_data
 from fenics_contact.solvers import STRATEGIES, make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings, Status
 from fenics_contact.solvers.linear import LinearSolverSettings
@@ -70,5 +70,6 @@ __all__ = [
     "make_strategy",
     "material",
     "run_scene",
+    "scene_from_data",
     "solve_load_path",
 ]

@@ -376,6 +376,17 @@ def load_scene(path: Path | str) -> Scene:
         raise SceneError(f"{path.name}: not a text file (not UTF-8); give a TOML scene.") from None
     except OSError as exc:
         raise SceneError(f"Scene file {path} cannot be read ({exc.strerror}).") from None
+    return scene_from_data(data, path)
+
+
+def scene_from_data(data: dict[str, Any], path: Path | str) -> Scene:
+    """Validate a scene given as the TOML document's data (nested dicts and lists).
+
+    The route of scenes written in Python: the same checks and messages as
+    :func:`load_scene`. ``path`` names the scene in messages, and relative
+    mesh files are found beside it (it need not exist).
+    """
+    path = Path(path)
     _check_keys(path, "", data)
     _check_finite(path, data)
     head = _table(path, data, "scene")
