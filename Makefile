@@ -8,7 +8,7 @@ MPIEXEC ?= $(shell [ -x $(BIN)/mpiexec ] && echo $(BIN)/mpiexec || echo mpiexec)
 OUT     ?= results
 
 .PHONY: demo test test-serial test-mpi soak venv meshes lint clean paper-tables paper-ex1-geometry \
-        cattaneo-mindlin
+        cattaneo-mindlin tradeoff stability benchmarks
 
 venv: $(VENV)/.installed
 
@@ -43,18 +43,33 @@ soak: venv
 meshes: venv
 	$(BIN)/fenics-contact mesh
 
+# The laboratory (benchmarks/: research, validation, robustness, performance).
 # The paper's Tables 1 and 2 beside ours (Example 1 also beside the wedge analog).
 paper-tables: venv
-	$(BIN)/fenics-contact study paper-ex1 --beside paper-ex1-wedge --out $(OUT)/paper-ex1
-	$(BIN)/fenics-contact study paper-ex2 --out $(OUT)/paper-ex2-study
+	$(BIN)/python benchmarks/research/study.py paper-ex1 --beside paper-ex1-wedge \
+	    --out $(OUT)/paper-ex1
+	$(BIN)/python benchmarks/research/study.py paper-ex2 --out $(OUT)/paper-ex2-study
 
 # The search that reconstructs Example 1's geometry from the paper's numbers (~2 min).
 paper-ex1-geometry: venv
-	$(BIN)/python benchmarks/paper_ex1_geometry.py --figure docs/images/paper_ex1_geometry.png
+	$(BIN)/python benchmarks/research/paper_ex1_geometry.py --figure docs/images/paper_ex1_geometry.png
 
 # Cattaneo-Mindlin with two identical cylinders on three meshes, and the README picture (~1-2 min).
 cattaneo-mindlin: venv
-	$(BIN)/python benchmarks/cattaneo_mindlin.py --out $(OUT)/bench --figure docs/images/cattaneo_mindlin.png
+	$(BIN)/python benchmarks/validation/cattaneo_mindlin.py --out $(OUT)/bench \
+	    --figure docs/images/cattaneo_mindlin.png
+
+# Speed against accuracy: Hertz, the bar and the sliding block, methods x r x 3 meshes.
+tradeoff: venv
+	$(BIN)/python benchmarks/research/tradeoff.py --scene all --out $(OUT)/tradeoff
+
+# Every method on the grid of extreme cases.
+stability: venv
+	$(BIN)/python benchmarks/robustness/stability_grid.py --out $(OUT)/stability
+
+# The performance benchmarks (minutes to hours; --quick stops at 1e5 DOFs).
+benchmarks: venv
+	$(BIN)/python benchmarks/run_all.py --quick
 
 lint: venv
 	$(BIN)/ruff check fenics_contact tests demos benchmarks

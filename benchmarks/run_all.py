@@ -39,8 +39,8 @@ def call(cmd: list[str]) -> None:
 
 def ladder_case(dofs: float, solver: str, ranks: int, repeats: int) -> None:
     """One ladder case in its own process (under mpiexec for ranks > 1)."""
-    cmd = [PYTHON, str(HERE / "ladder3d.py"), "--dofs", f"{dofs:g}", "--solver", solver,
-           "--repeats", str(repeats)]
+    cmd = [PYTHON, str(HERE / "performance" / "ladder3d.py"), "--dofs", f"{dofs:g}",
+           "--solver", solver, "--repeats", str(repeats)]
     call(([MPIEXEC, "-n", str(ranks)] if ranks > 1 else []) + cmd)
 
 
@@ -53,13 +53,13 @@ def main() -> None:
     parts = set(args.only.split(","))
     limit = 1e5 if args.quick else 1e6
     if "hertz2d" in parts:
-        call([PYTHON, str(HERE / "hertz2d.py")])
+        call([PYTHON, str(HERE / "validation" / "hertz2d.py")])
     if "cost" in parts:
-        call([PYTHON, str(HERE / "cost_of_contact.py")])
+        call([PYTHON, str(HERE / "performance" / "cost_of_contact.py")])
     if "compile" in parts:
-        call([PYTHON, str(HERE / "compile_cost.py")])
+        call([PYTHON, str(HERE / "performance" / "compile_cost.py")])
     if "hertz3d" in parts:
-        call([PYTHON, str(HERE / "hertz3d.py")])
+        call([PYTHON, str(HERE / "validation" / "hertz3d.py")])
     for dofs, solver, ranks, repeats in LADDER:
         wanted = "mpi" in parts if ranks > 1 else "ladder" in parts
         if wanted and dofs <= limit:
@@ -69,7 +69,7 @@ def main() -> None:
             ladder_case(dofs, "iterative", 1, repeats)
             ladder_case(dofs, "iterative", 2, repeats)
     if parts & {"ladder", "mpi", "speedup"}:
-        call([PYTHON, str(HERE / "ladder3d.py"), "--table"])
+        call([PYTHON, str(HERE / "performance" / "ladder3d.py"), "--table"])
 
 
 if __name__ == "__main__":

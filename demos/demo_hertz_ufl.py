@@ -30,7 +30,7 @@
 #
 # Only the analytic Hertz formulas and the gmsh-to-DOLFINx helper come from
 # `fenics_contact`; the formulation is all on this page. The library builds
-# the same problem in `fenics_contact.verification.hertz_problem`
+# the same problem from the shipped scene `scenes/hertz_cylinder.toml`
 # (`demos/hertz_cylinder.py` runs it), and both give the same numbers.
 #
 # Run it as a script, `python demos/demo_hertz_ufl.py [--out DIR]`, in
@@ -76,12 +76,12 @@ import dolfinx.fem.petsc
 import ufl
 from dolfinx import default_scalar_type, fem, la, mesh
 
-from fenics_contact.scene.meshing import CONTACT_TAG, TOP_TAG, mesh_on_rank
-from fenics_contact.verification.hertz import (
+from fenics_contact.references.hertz import (
     fit_contact_profile,
     hertz_line_contact,
     relative_error,
 )
+from fenics_contact.scene.meshing import mesh_on_rank
 
 parser = argparse.ArgumentParser(description="Hertz line contact written out in UFL")
 parser.add_argument(
@@ -152,6 +152,8 @@ def mesh_geo(gmsh) -> None:
     gmsh.model.mesh.generate(2)
 
 
+#: The .geo's physical curves: "top" (the flat face) and "contact" (the arc).
+TOP_TAG, CONTACT_TAG = 2, 3
 mesh_data = mesh_on_rank(comm, 0, 2, mesh_geo)
 msh = mesh_data.mesh
 facet_tags = mesh_data.facet_tags

@@ -11,7 +11,8 @@
 # # Hertz line contact: an elastic cylinder on a rigid plane
 #
 # This demo validates the frictionless contact formulation against Hertz
-# theory in 2D. A small-strain linear elastic half-cylinder (plane strain,
+# theory in 2D on the shipped scene `scenes/hertz_cylinder.toml`. A
+# small-strain linear elastic half-cylinder (plane strain,
 # radius R = 1, E = 200, nu = 0.3) is pushed onto the rigid plane y = 0 by
 # moving its flat top face down. The contact problem is solved with GNRM
 # (generalized Newton on displacement and Alart-Curnier multiplier, nodal
@@ -51,11 +52,11 @@ import numpy as np
 
 from mpi4py import MPI
 
-from fenics_contact.model.contact import ContactSettings
+from fenics_contact import build_problem, load_scene
+from fenics_contact.references.measure import contact_profile, measure_hertz
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings, signorini_report
 from fenics_contact.solvers.stepping import StepRecord, solve_load_path
-from fenics_contact.verification.hertz_problem import HertzCylinder, contact_profile, measure_hertz
 
 parser = argparse.ArgumentParser(description="Hertz line contact validation")
 parser.add_argument(
@@ -63,6 +64,12 @@ parser.add_argument(
     type=Path,
     default=Path("results/hertz_cylinder"),
     help="output directory (default: results/hertz_cylinder)",
+)
+parser.add_argument(
+    "--scene",
+    type=Path,
+    default=Path(__file__).resolve().parents[1] / "scenes" / "hertz_cylinder.toml",
+    help="the Hertz scene (default: scenes/hertz_cylinder.toml)",
 )
 parser.add_argument("--steps", type=int, default=4, help="load steps (default: 4)")
 args, _ = parser.parse_known_args()  # tolerate notebook kernel arguments
@@ -80,17 +87,22 @@ def say(*text: object) -> None:
 # %% [markdown]
 # ## The problem
 #
-# The mesh is the lower half-disk graded with gmsh: elements of size
-# `h_contact = 0.004 R` within 0.1 R of the contact point, growing to
-# `0.1 R` further away. The push of 0.01 R gives a half-width of about
-# 0.08 R, small enough for Hertz's half-space assumption and spanned by
-# about 20 elements. Only arc facets below y = 0.02 R carry multipliers.
+# The mesh (`meshes/hertz_cylinder.geo`) is the lower half-disk graded with
+# gmsh: elements of size `h_contact = 0.004 R` within 0.1 R of the contact
+# point, growing to `0.1 R` further away. The push of 0.01 R gives a
+# half-width of about 0.08 R, small enough for Hertz's half-space assumption
+# and spanned by about 20 elements. The arc's facets carry the multipliers
+# (nodal quadrature, r = 1 relative to E/h).
 
 # %%
-cylinder = HertzCylinder()
-settings = ContactSettings(r=1.0, relative=True, quadrature="nodal")
+cylinder = load_scene(args.scene)
+mesh_parameters = {"radius": 1.0, "fine_radius": 0.1, "coarse_radius": 0.5,  # the .geo's
+                   **cylinder.mesh.parameters}
+radius, h_contact = mesh_parameters["radius"], mesh_parameters["h_contact"]
+push = -cylinder.dirichlet[0].value[1]  # the flat top's downward displacement
+settings = cylinder.contact
 start = time.perf_counter()
-problem = cylinder.build(settings, comm)
+problem = build_problem(cylinder, comm)
 n_dofs = problem.V.dofmap.index_map.size_global * problem.V.dofmap.index_map_bs
 n_lam = problem.surface.num_dofs
 say(
@@ -111,11 +123,11 @@ history: list[dict] = []
 
 def record(step: StepRecord) -> None:
     """Compare the converged step with Hertz theory."""
-    c = measure_hertz(problem, cylinder)
+    c = measure_hertz(problem, radius, cylinder.E, cylinder.nu)
     history.append(
         {
             "step": step.step,
-            "push": step.load_factor * cylinder.push,
+            "push": step.load_factor * push,
             "iterations": step.iterations,
             "active_nodes": step.active_count,
             "P": c.P,
@@ -148,7 +160,7 @@ for h in history:
 # ## Comparison at full load
 
 # %%
-comparison = measure_hertz(problem, cylinder)
+comparison = measure_hertz(problem, radius, cylinder.E, cylinder.nu)
 state = problem.contact_state()
 kkt = signorini_report(state.gap, state.pressure, comm)
 hertz = comparison.hertz
@@ -159,7 +171,7 @@ rows = [
 ]
 say(
     f"\nTotal contact force P = {comparison.P:.6f} per unit thickness; "
-    f"a/R = {hertz.a / cylinder.radius:.4f}, a/h_contact = {hertz.a / cylinder.h_contact:.1f}, "
+    f"a/R = {hertz.a / radius:.4f}, a/h_contact = {hertz.a / h_contact:.1f}, "
     f"{comparison.fit.n_contact} nodes in contact"
 )
 say(f"{'quantity':<26} {'FE':>10} {'Hertz':>10} {'error':>8}")
@@ -179,18 +191,15 @@ if root:
     args.out.mkdir(parents=True, exist_ok=True)
     summary = {
         "problem": {
-            "radius": cylinder.radius,
+            "scene": cylinder.name,
+            "radius": radius,
             "E": cylinder.E,
             "nu": cylinder.nu,
-            "push": cylinder.push,
+            "push": push,
             "material": "linear elastic, plane strain",
         },
         "mesh": {
-            "h_contact": cylinder.h_contact,
-            "h_far": cylinder.h_far,
-            "fine_radius": cylinder.fine_radius,
-            "coarse_radius": cylinder.coarse_radius,
-            "contact_band": cylinder.contact_band,
+            **mesh_parameters,
             "displacement_dofs": n_dofs,
             "multiplier_dofs": n_lam,
         },
@@ -236,7 +245,7 @@ if root:
     ax.set_xlabel("x (reference)")
     ax.set_ylabel("contact pressure -lam")
     ax.set_title(
-        f"Hertz cylinder: a/R = {hertz.a / cylinder.radius:.3f}, "
+        f"Hertz cylinder: a/R = {hertz.a / radius:.3f}, "
         f"{comparison.fit.n_contact} nodes in contact"
     )
     ax.legend(loc="upper right", fontsize=8)

@@ -3,7 +3,8 @@
 #
 # This demo illustrates how to:
 #
-# - build the Example 2 analog of Heegaard, Hovey and Kaplan: a plane-strain
+# - load the Example 2 analog of Heegaard, Hovey and Kaplan, the shipped scene
+#   `scenes/paper_ex2.toml`: a plane-strain
 #   bar of 6 x 2 bilinear quadrilaterals (12 elements, 7 contact nodes on its
 #   lower face), St. Venant-Kirchhoff with E = 210, nu = 0.3;
 # - solve it with the generalized Newton method (GNRM) on displacement and
@@ -30,17 +31,20 @@ import numpy as np
 
 from mpi4py import MPI
 
-from fenics_contact.model.contact import ContactSettings
+from fenics_contact import build_problem, load_scene
 from fenics_contact.output.io import write_json
 from fenics_contact.output.xdmf import StepWriter
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.stepping import solve_load_path
-from fenics_contact.studies.study import paper_table, reference_solution, run_one
-from fenics_contact.verification.examples import BarOnCradle
+from fenics_contact.sweeps.study import paper_table, reference_solution, run_one
 
 parser = argparse.ArgumentParser(description=__doc__)
 parser.add_argument("--out", type=Path, default=Path("results/paper-ex2"))
+parser.add_argument(
+    "--scene", type=Path,
+    default=Path(__file__).resolve().parents[1] / "scenes" / "paper_ex2.toml",
+)
 args = parser.parse_args()
 out: Path = args.out
 
@@ -56,8 +60,8 @@ def say(*text: object) -> None:
 # The contact pattern of each step: `#` a node in contact, `.` an open gap.
 
 # %%
-example = BarOnCradle()
-problem = example.build(ContactSettings(r=100.0, relative=False))
+example = load_scene(args.scene)  # r = 100 (absolute), nodal rule, 10 load steps
+problem = build_problem(example)
 strategy = make_strategy("gnrm", problem, SolverSettings(atol=1e-8, max_iterations=500))
 writer = StepWriter(problem, out / "solution.xdmf")
 patterns = []
@@ -77,7 +81,7 @@ def report(step) -> None:
     writer.write(step.load_factor)
 
 
-path = solve_load_path(strategy, example.steps, max_cutbacks=0, on_step=report)
+path = solve_load_path(strategy, example.solver.steps, max_cutbacks=0, on_step=report)
 writer.close()
 
 # %% [markdown]

@@ -18,11 +18,13 @@ The public API, in the order a run uses it::
     # or all of it, with XDMF/JSON/pictures: run_scene(scene, Path("results/x"))
 
 Layers (each imports only those above it in this list): ``model`` (materials,
-obstacles, contact terms, the problem and its UFL systems), ``solvers``
-(Newton kernel, strategies, load stepping, the run record), ``scene`` (TOML
-schema, meshes, building) and ``output`` (XDMF, JSON, pictures),
-``verification`` (problems with known answers), ``studies`` (sweeps),
-``runner`` and ``cli``.
+obstacles, contact terms, the problem and its UFL systems), ``references``
+(Hertz, Cattaneo-Mindlin: closed forms and the measurements against them),
+``solvers`` (Newton kernel, strategies, load stepping, the run record),
+``scene`` (TOML schema, meshes, building) and ``output`` (XDMF, JSON,
+pictures), ``sweeps`` (method x r studies, speed against accuracy,
+stability), ``runner`` and ``cli``. The laboratory (the paper's studies, the
+sweeps' case lists, the benchmarks) is ``benchmarks/``, outside the package.
 """
 
 from __future__ import annotations

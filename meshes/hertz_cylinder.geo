@@ -1,8 +1,7 @@
 // Plane-strain Hertz validation: the lower half of a disk on the plane y = 0.
 //
-// The same geometry, grading and physical tags as
-// fenics_contact.meshing.hertz_half_disk (and HertzCylinder's defaults):
-// the half-disk {x^2 + (y - R)^2 <= R^2, y <= R}, centre (0, R), touching
+// The geometry of scenes/hertz_cylinder.toml and of benchmarks/cases.py
+// (hertz_cylinder): the half-disk {x^2 + (y - R)^2 <= R^2, y <= R}, centre (0, R), touching
 // y = 0 at (0, 0), which is a mesh vertex. P1 triangles of size h_contact
 // within fine_radius of (0, 0), growing linearly to h_far at coarse_radius.
 //

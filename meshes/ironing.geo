@@ -1,6 +1,6 @@
 // Ironing: a half-disk indenter (centre (0, R), flat face y = R, touching the
-// origin) above a block [-1, L - 1] x [-D, 0]. Same geometry and tags as
-// fenics_contact.scene.two_body_meshing.ironing.
+// origin) above a block [-1, L - 1] x [-D, 0] (scenes/ironing.toml,
+// scenes/ironing_friction.toml, benchmarks/cases.py: ironing).
 //
 // Physical groups:
 //   Surface "striker" = 1 (indenter), Surface "target" = 2 (block)    (cell tags)

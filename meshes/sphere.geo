@@ -1,7 +1,6 @@
 // 3D Hertz validation: one eighth of a sphere resting on the plane z = 0.
 //
-// The same geometry, grading and physical tags as
-// fenics_contact.meshing.hertz_sphere_octant (and HertzSphere's defaults):
+// The geometry of benchmarks/cases.py (hertz_sphere):
 // {x >= 0, y >= 0, z <= R, x^2 + y^2 + (z - R)^2 <= R^2}, the quarter of the
 // lower hemisphere of the sphere centred at (0, 0, R); it touches z = 0 at the
 // origin, a mesh vertex. P1 tetrahedra of size h_contact within fine_radius

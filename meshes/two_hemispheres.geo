@@ -2,8 +2,7 @@
 //
 // Upper (striker): ball centre (0, 0, R) cut to z in [0, R]; lower (target):
 // ball centre (0, 0, -R) cut to z in [-R, 0]. Meshed independently with
-// tetrahedra (non-matching at the contact). Same geometry and tags as
-// fenics_contact.scene.two_body_meshing.two_hemispheres.
+// tetrahedra (non-matching at the contact); scenes/two_hemispheres_3d.toml.
 //
 // Physical groups:
 //   Volume "striker" = 1, Volume "target" = 2                         (cell tags)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 import fenics_contact
-from fenics_contact.verification.hertz_problem import HertzCylinder, measure_hertz
+from fenics_contact.references.measure import measure_hertz
 
 
 @pytest.mark.parametrize("name", fenics_contact.__all__)
@@ -37,6 +37,6 @@ def test_readme_python_example_matches_hertz():
     assert record.converged and record.method == "gnrm"
     assert record.steps_completed == scene.solver.steps
     assert record.max_penetration < 1e-12
-    # the same geometry as the HertzCylinder validation problem: Hertz to mesh accuracy
-    comparison = measure_hertz(problem, HertzCylinder())
+    # the same geometry as the hertz_cylinder validation case: Hertz to mesh accuracy
+    comparison = measure_hertz(problem, 1.0, 200.0, 0.3)
     assert abs(comparison.a_error) < 0.01 and abs(comparison.p0_error) < 0.01

@@ -5,24 +5,23 @@ import pytest
 
 from mpi4py import MPI
 
-from fenics_contact.model.contact import ContactSettings
+from benchmarks import cases
 from fenics_contact.model.scaling import force_scale, residual_floor, scaled_atol
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.auto import AutoStrategy
 from fenics_contact.solvers.diagnostics import SolverSettings, Status
 from fenics_contact.solvers.stepping import solve_load_path
-from fenics_contact.verification.bench_scenes import BarScene, HertzScene
 
-BAR = BarScene()
+BAR = cases.bar_on_cradle()
 
 
 def solve(scene, method, r, quadrature="nodal", comm=MPI.COMM_WORLD, **settings):
-    problem = scene.build(ContactSettings(r=r, relative=True, quadrature=quadrature), comm)
+    problem = cases.build(scene, r, relative=True, quadrature=quadrature, comm=comm)
     options = {"atol": scaled_atol(problem), "max_iterations": 60, **settings}
     strategy = make_strategy(method, problem, SolverSettings(**options))
     switches = []
     path = solve_load_path(
-        strategy, scene.steps, max_cutbacks=0,
+        strategy, scene.solver.steps, max_cutbacks=0,
         on_iteration=lambda _, result: switches.extend(result.switches),
     )
     return problem, path, switches
@@ -50,7 +49,7 @@ def test_auto_converges_on_the_bar_where_gnrm_diverges(r, bar_reference):
 
 @pytest.mark.mpi
 def test_auto_converges_on_hertz_at_r_1e10_where_gnrm_diverges():
-    scene = HertzScene(h_contact=0.02)
+    scene = cases.hertz_cylinder(0.02)
     _, gnrm, _ = solve(scene, "gnrm", 1e10)
     assert gnrm.status == Status.DIVERGED
     reference, _, _ = solve(scene, "gnrm", 1.0)
@@ -72,12 +71,12 @@ def test_auto_costs_what_gnrm_costs_where_gnrm_works():
 
 
 def test_line_search_stage_reaches_the_same_answer(bar_reference):
-    problem = BAR.build(ContactSettings(r=1.0), MPI.COMM_WORLD)
+    problem = cases.build(BAR, 1.0, comm=MPI.COMM_WORLD)
     strategy = AutoStrategy(problem, SolverSettings(atol=scaled_atol(problem)))
     from fenics_contact.solvers.auto import _Tally
 
-    for k in range(1, BAR.steps + 1):
-        problem.set_load(k / BAR.steps)
+    for k in range(1, BAR.solver.steps + 1):
+        problem.set_load(k / BAR.solver.steps)
         tally = _Tally()
         status = strategy._newton(strategy._stage_settings(problem.r_absolute), tally,
                                   line_search=True)
@@ -87,16 +86,16 @@ def test_line_search_stage_reaches_the_same_answer(bar_reference):
 
 
 def test_gauss_rule_climbs_to_the_users_r_by_continuation():
-    problem = BAR.build(ContactSettings(r=1e4, quadrature="gauss"), MPI.COMM_WORLD)
+    problem = cases.build(BAR, 1e4, quadrature="gauss", comm=MPI.COMM_WORLD)
     rungs = AutoStrategy(problem, SolverSettings()).rungs()
     assert rungs[0] == pytest.approx(1e2 * problem.stiffness_scale)
     assert rungs[-1] == pytest.approx(problem.r_absolute) and len(rungs) == 2
     auto, path, switches = solve(BAR, "auto", 1e3, quadrature="gauss")
     assert path.converged and any(s.startswith("continuation") for s in switches)
-    gnrm = BAR.build(ContactSettings(r=1e3, quadrature="gauss"), MPI.COMM_WORLD)
+    gnrm = cases.build(BAR, 1e3, quadrature="gauss", comm=MPI.COMM_WORLD)
     solve_load_path(make_strategy("gnrm", gnrm, SolverSettings(atol=scaled_atol(gnrm),
                                                                  max_iterations=60)),
-                    BAR.steps, max_cutbacks=4)
+                    BAR.solver.steps, max_cutbacks=4)
     scale = np.abs(gnrm.u.x.array).max()
     assert np.abs(auto.u.x.array - gnrm.u.x.array).max() < 1e-8 * scale
 
@@ -104,13 +103,13 @@ def test_gauss_rule_climbs_to_the_users_r_by_continuation():
 def test_stopping_test_never_demands_less_than_the_round_off_floor():
     """At r = 1e10 E/h plain GNRM stalls near eps r g_scale ||A||; with the floor in the
     tolerance (and no growth test) it stops there instead of running to the limit."""
-    problem = BAR.build(ContactSettings(r=1e10), MPI.COMM_WORLD)
+    problem = cases.build(BAR, 1e10, comm=MPI.COMM_WORLD)
     floor = residual_floor(problem)
     assert scaled_atol(problem) == pytest.approx(floor)
     assert floor > 1e-8 and floor < 1e-3 * force_scale(problem)
     strict = make_strategy("gnrm", problem, SolverSettings(atol=1e-3 * floor, max_iterations=30,
                                                            divergence_factor=1e300))
-    path = solve_load_path(strict, BAR.steps, max_cutbacks=0)
+    path = solve_load_path(strict, BAR.solver.steps, max_cutbacks=0)
     assert path.status == Status.MAX_ITERATIONS
     _, path, _ = solve(BAR, "gnrm", 1e10, divergence_factor=1e300)
     assert path.converged
@@ -118,13 +117,13 @@ def test_stopping_test_never_demands_less_than_the_round_off_floor():
 
 def test_auto_reports_residual_progress_through_every_stage():
     """The observer hears every residual of every stage, with iterations counted over the solve."""
-    problem = BAR.build(ContactSettings(r=1e8, relative=True))
+    problem = cases.build(BAR, 1e8, relative=True)
     heard = []
     strategy = make_strategy(
         "auto", problem, SolverSettings(atol=scaled_atol(problem), max_iterations=60),
         observer=lambda iterations, residual: heard.append((iterations, residual)),
     )
-    problem.set_load(1.0 / BAR.steps)
+    problem.set_load(1.0 / BAR.solver.steps)
     result = strategy.solve()
     assert result.converged
     assert [r for _, r in heard] == result.residuals
@@ -135,10 +134,10 @@ def test_auto_reports_residual_progress_through_every_stage():
 def test_auto_fallback_kernels_use_the_configured_linear_solver():
     from fenics_contact.solvers.linear import LinearSolverSettings
 
-    problem = BAR.build(ContactSettings(r=1.0, relative=True))
+    problem = cases.build(BAR, 1.0, relative=True)
     iterative = LinearSolverSettings(kind="iterative")
     strategy = AutoStrategy(problem, SolverSettings(), linear=iterative)
-    problem.set_load(1.0 / BAR.steps)
+    problem.set_load(1.0 / BAR.solver.steps)
     settings = SolverSettings(atol=scaled_atol(problem))
     from fenics_contact.solvers.auto import _Tally
 

@@ -6,20 +6,19 @@ from dolfinx import mesh
 
 from mpi4py import MPI
 
+from benchmarks import cases
 from fenics_contact.model.candidates import boundary_facets, detect_candidate_facets
-from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.obstacles import RigidBall
 from fenics_contact.model.scaling import scaled_atol
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.stepping import solve_load_path
-from fenics_contact.verification.bench_scenes import BarScene, HertzScene
 
 
 def solved(scene):
-    problem = scene.build(ContactSettings(r=1.0), MPI.COMM_WORLD)
+    problem = cases.build(scene, 1.0, comm=MPI.COMM_WORLD)
     settings = SolverSettings(atol=scaled_atol(problem), max_iterations=60)
-    path = solve_load_path(make_strategy("gnrm", problem, settings), scene.steps)
+    path = solve_load_path(make_strategy("gnrm", problem, settings), scene.solver.steps)
     assert path.converged
     return problem
 
@@ -36,13 +35,13 @@ def facet_points(domain, facets):
     return domain.geometry.x[nodes.ravel()]
 
 
-@pytest.mark.parametrize("scene", [HertzScene(h_contact=0.02), BarScene()],
-                         ids=["hertz", "bar"])
-def test_detection_keeps_every_node_a_whole_boundary_run_brings_into_contact(scene):
-    whole = solved(type(scene)(**{**scene.__dict__, "candidates": "boundary"}))
+@pytest.mark.parametrize("family", [lambda **kw: cases.hertz_cylinder(0.02, **kw),
+                                    cases.bar_on_cradle], ids=["hertz", "bar"])
+def test_detection_keeps_every_node_a_whole_boundary_run_brings_into_contact(family):
+    whole = solved(family(candidates="boundary"))
     touched = contact_points(whole)
     assert touched.shape[0] > 0
-    detected = solved(type(scene)(**{**scene.__dict__, "candidates": "detected"}))
+    detected = solved(family(candidates="detected"))
     kept = np.concatenate(
         MPI.COMM_WORLD.allgather(facet_points(detected.domain, detected.surface.facets))
     )

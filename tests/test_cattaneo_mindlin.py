@@ -3,7 +3,7 @@
 scenes/cattaneo_mindlin.toml with h = 0.006 at contact (33 nodes across
 2a, matching arcs) instead of 0.003, in 6 steps (2 pressing, 4 shifting)
 instead of 12: Q/(mu P) = 0.23, 0.45, 0.67, 0.87. The shipped mesh is
-measured in benchmarks/cattaneo_mindlin.py.
+measured in benchmarks/validation/cattaneo_mindlin.py.
 """
 
 import json
@@ -12,10 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from benchmarks.validation.cattaneo import pressing_check, shear_start, solve_cattaneo_mindlin
 from fenics_contact.cli import main
+from fenics_contact.references.cattaneo import two_cylinders_hertz
 from fenics_contact.scene.schema import load_scene
-from fenics_contact.studies.cattaneo import pressing_check, shear_start, solve_cattaneo_mindlin
-from fenics_contact.verification.cattaneo import two_cylinders_hertz
 
 SCENE = Path(__file__).parent.parent / "scenes" / "cattaneo_mindlin.toml"
 MU = 0.3

@@ -41,28 +41,36 @@ COMMANDS: dict[str, str | tuple[str, str]] = {
     # (the import order that once broke cost_of_contact.py) and the cheap ones run
     "python benchmarks/run_all.py": "{python} benchmarks/run_all.py --help",
     "python benchmarks/run_all.py --quick": "{python} benchmarks/run_all.py --help",
-    "python benchmarks/hertz2d.py": "{python} benchmarks/hertz2d.py --help",
-    "python benchmarks/cost_of_contact.py": "{python} benchmarks/cost_of_contact.py --help",
-    "python benchmarks/hertz3d.py": "{python} benchmarks/hertz3d.py --help",
-    "python benchmarks/compile_cost.py": "{python} benchmarks/compile_cost.py --help",
-    "python benchmarks/ladder3d.py --dofs 1e5 --solver iterative":
-        "{python} benchmarks/ladder3d.py --dofs 1e3 --solver iterative --repeats 1 --out {out}",
-    "mpiexec -n 2 python benchmarks/ladder3d.py --dofs 1e6 --solver iterative --repeats 1":
-        "{mpiexec} -n 2 {python} benchmarks/ladder3d.py --dofs 1e3 --solver iterative "
+    "python benchmarks/validation/hertz2d.py": "{python} benchmarks/validation/hertz2d.py --help",
+    "python benchmarks/performance/cost_of_contact.py":
+        "{python} benchmarks/performance/cost_of_contact.py --help",
+    "python benchmarks/validation/hertz3d.py": "{python} benchmarks/validation/hertz3d.py --help",
+    "python benchmarks/performance/compile_cost.py":
+        "{python} benchmarks/performance/compile_cost.py --help",
+    "python benchmarks/performance/ladder3d.py --dofs 1e5 --solver iterative":
+        "{python} benchmarks/performance/ladder3d.py --dofs 1e3 --solver iterative --repeats 1 "
+        "--out {out}",
+    "mpiexec -n 2 python benchmarks/performance/ladder3d.py --dofs 1e6 --solver iterative "
+    "--repeats 1":
+        "{mpiexec} -n 2 {python} benchmarks/performance/ladder3d.py --dofs 1e3 --solver "
+        "iterative --repeats 1 --out {out}",
+    "python benchmarks/performance/ladder3d.py --table":
+        "{python} benchmarks/performance/ladder3d.py --table --out {out}",
+    "python benchmarks/research/tradeoff.py --out results/tradeoff":
+        "{python} benchmarks/research/tradeoff.py --scene bar --methods gnrm --r 1 --meshes 1 "
         "--repeats 1 --out {out}",
-    "python benchmarks/ladder3d.py --table": "{python} benchmarks/ladder3d.py --table --out {out}",
-    "fenics-contact tradeoff --out results/tradeoff":
-        "{cli} tradeoff --scene bar --methods gnrm --r 1 --meshes 1 --repeats 1 --out {out}",
-    "fenics-contact tradeoff --scene friction --mu 0.1,0.3 --repeats 1 --meshes 3 "
-    "--out results/trf":
-        "{cli} tradeoff --scene friction --mu 0.3 --methods gnrm --r 1 --meshes 1 "
-        "--repeats 1 --out {out}",
-    "fenics-contact stability --out results/stability":
-        "{cli} stability --cases bar-r1e0 --methods gnrm --out {out}",
-    "fenics-contact stability --cases E,bar-r1e12 --methods gnrm,auto":
-        "{cli} stability --cases bar-E1e3,bar-r1e12 --methods gnrm,auto --out {out}",
-    "python benchmarks/candidate_facets.py":
-        "{python} benchmarks/candidate_facets.py --help",
+    "python benchmarks/research/tradeoff.py --scene friction --mu 0.1,0.3 --repeats 1 "
+    "--meshes 3 --out results/trf":
+        "{python} benchmarks/research/tradeoff.py --scene friction --mu 0.3 --methods gnrm "
+        "--r 1 --meshes 1 --repeats 1 --out {out}",
+    "python benchmarks/robustness/stability_grid.py --out results/stability":
+        "{python} benchmarks/robustness/stability_grid.py --cases bar-r1e0 --methods gnrm "
+        "--out {out}",
+    "python benchmarks/robustness/stability_grid.py --cases E,bar-r1e12 --methods gnrm,auto":
+        "{python} benchmarks/robustness/stability_grid.py --cases bar-E1e3,bar-r1e12 "
+        "--methods gnrm,auto --out {out}",
+    "python benchmarks/performance/candidate_facets.py":
+        "{python} benchmarks/performance/candidate_facets.py --help",
     "fenics-contact run SCENE --resume DIR":
         ("skip", "a template; tests/test_interrupt.py stops and resumes real runs"),
     "mpiexec -n 2 fenics-contact run SCENE --resume DIR":

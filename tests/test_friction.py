@@ -12,7 +12,8 @@ import pytest
 
 from mpi4py import MPI
 
-from fenics_contact.model.contact import ContactSettings
+from benchmarks import cases
+from benchmarks.cases import OBLIQUE
 from fenics_contact.model.friction import SLIP, STICK
 from fenics_contact.model.scaling import force_scale, scaled_atol
 from fenics_contact.scene.build import build_problem
@@ -20,7 +21,6 @@ from fenics_contact.scene.schema import SceneError, load_scene
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings, convergence_order
 from fenics_contact.solvers.stepping import solve_load_path
-from fenics_contact.verification.friction_scenes import OBLIQUE, SlidingBlock
 
 SCENE = Path(__file__).parent.parent / "scenes" / "block_slide_friction.toml"
 MU = 0.3
@@ -93,11 +93,11 @@ def test_parallel_matches_serial_iterations_and_forces(gnrm_run):
 
 def _block_run(mu, schedule):
     """GNRM at r = 1 E/h on the sliding block in code (same settings as :func:`solve`)."""
-    block = SlidingBlock(mu=mu, schedule=schedule)
-    problem = block.build(ContactSettings(r=1.0, relative=True))
+    block = cases.sliding_block(mu, schedule=schedule)
+    problem = cases.build(block, 1.0, relative=True)
     strategy = make_strategy("gnrm", problem, SolverSettings(atol=1e-8, rtol=1e-10,
                                                              max_iterations=100))
-    return problem, solve_load_path(strategy, block.steps, max_cutbacks=0)
+    return problem, solve_load_path(strategy, block.solver.steps, max_cutbacks=0)
 
 
 def _tail(problem, run, steps):
@@ -292,8 +292,7 @@ def test_obstacle_follows_its_schedule():
 
 def test_cattaneo_mindlin_stick_zone_of_a_cylinder_on_a_rigid_plane():
     """Interim check (beta = 0.09, frictionless pressing): c = a sqrt(1 - Q/(mu P))."""
-    from fenics_contact.studies.cattaneo import solve_cattaneo
-    from fenics_contact.verification.cattaneo import CattaneoCylinder
+    from benchmarks.validation.cattaneo import CattaneoCylinder, solve_cattaneo
 
     _, zones, iterations = solve_cattaneo(
         CattaneoCylinder(shift=0.003), press_steps=2, shear_steps=4
@@ -359,16 +358,17 @@ def test_block_slides_diagonally_in_3d(tmp_path):
 
 
 def test_stability_grid_friction_cases_end_with_a_status():
-    from fenics_contact.studies.stability import friction_grid, run_case
+    from benchmarks.robustness.stability_grid import friction_grid
+    from fenics_contact.sweeps.stability import run_case
 
-    cases = {c.name: c for c in friction_grid()}
+    grid = {c.name: c for c in friction_grid()}
     assert {"slide-mu0", "slide-mu10", "slide-r1e-8", "slide-r1e12", "slide-reversal"} <= set(
-        cases
+        grid
     )
-    uncapped = run_case(cases["slide-rt=r-r1e4"], "gnrm", max_iterations=30)
+    uncapped = run_case(grid["slide-rt=r-r1e4"], "gnrm", max_iterations=30)
     assert uncapped.status == "max_iterations" and uncapped.steps_completed == PRESS_STEPS
     for method in ("gnrm", "auto"):
-        record = run_case(cases["slide-r1e4"], method)
+        record = run_case(grid["slide-r1e4"], method)
         assert record.status == "converged"
         assert record.steps[-1].tangential_force == pytest.approx(
             SERIAL_TANGENTIAL_FORCE, rel=1e-8
@@ -391,7 +391,7 @@ def test_iterative_linear_solver_takes_both_multipliers_in_one_split():
 def test_tangential_cap_follows_the_body_not_the_mesh():
     """r_t = min(r, 2 E/L), L = 1 the contact surface extent: 2000 on every mesh (E/h grows)."""
     for k in (1, 2, 4):
-        problem = SlidingBlock(nx=10 * k, ny=5 * k).build(ContactSettings(r=1.0, relative=True))
+        problem = cases.build(cases.sliding_block(nx=10 * k, ny=5 * k), 1.0, relative=True)
         assert problem.contact_extent == pytest.approx(1.0, rel=1e-12)
         assert problem.tangential_r == pytest.approx(2000.0, rel=1e-12)
         assert problem.stiffness_scale == pytest.approx(1e4 * k, rel=1e-12)
@@ -399,7 +399,7 @@ def test_tangential_cap_follows_the_body_not_the_mesh():
 
 def _refined_run(cap=None):
     """GNRM at r = 1 E/h on the 40x20 block (stopping test of the trade-off sweep)."""
-    problem = SlidingBlock(nx=40, ny=20).build(ContactSettings(r=1.0, relative=True))
+    problem = cases.build(cases.sliding_block(nx=40, ny=20), 1.0, relative=True)
     if cap is not None:
         problem.set_tangential_cap(cap)
     settings = SolverSettings(atol=scaled_atol(problem), max_iterations=200)
@@ -468,10 +468,10 @@ def test_sua_at_huge_r_is_not_converged_until_the_coulomb_law_holds(monkeypatch)
     import fenics_contact.solvers.diagnostics as diagnostics
     from fenics_contact.solvers.diagnostics import coulomb_admissibility, signorini_admissibility
 
-    block = SlidingBlock(schedule=FIRST_SLIDE, steps=9)
+    block = cases.sliding_block(schedule=FIRST_SLIDE, steps=9)
 
     def first_slide():
-        problem = block.build(ContactSettings(r=1e8, relative=True))
+        problem = cases.build(block, 1e8, relative=True)
         settings = SolverSettings(atol=scaled_atol(problem), max_iterations=100)
         verdicts = []
 

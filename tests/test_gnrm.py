@@ -8,19 +8,21 @@ import pytest
 
 from mpi4py import MPI
 
-from fenics_contact.model.contact import ContactSettings
+from benchmarks import cases
+from benchmarks.cases import PAPER_E
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings, signorini_report
 from fenics_contact.solvers.stepping import solve_load_path
-from fenics_contact.verification.examples import PAPER_E, BarOnCradle
 
-EXAMPLE = BarOnCradle()
+EXAMPLE = cases.bar_on_cradle()
+#: The cradle's radius and the bar's length (bar_on_cradle's defaults).
+RADIUS, LENGTH = 10.0, 6.0
 
 
 def solve(method="gnrm", r=1.0, relative=True, comm=MPI.COMM_WORLD, cutbacks=0, **kw):
-    problem = EXAMPLE.build(ContactSettings(r=r, relative=relative, **kw), comm)
+    problem = cases.build(EXAMPLE, r, relative, comm=comm, **kw)
     strategy = make_strategy(method, problem, SolverSettings(atol=1e-8, max_iterations=60))
-    path = solve_load_path(strategy, EXAMPLE.steps, max_cutbacks=cutbacks)
+    path = solve_load_path(strategy, EXAMPLE.solver.steps, max_cutbacks=cutbacks)
     return problem, path
 
 
@@ -32,11 +34,11 @@ def test_signorini_conditions_hold_at_every_converged_step():
         reports.append(signorini_report(state.gap, state.multiplier, problem.comm))
         patterns.append(state.active_count)
 
-    problem = EXAMPLE.build(ContactSettings(r=1.0), MPI.COMM_WORLD)
+    problem = cases.build(EXAMPLE, 1.0, comm=MPI.COMM_WORLD)
     strategy = make_strategy("gnrm", problem, SolverSettings(atol=1e-10))
-    path = solve_load_path(strategy, EXAMPLE.steps, max_cutbacks=0, on_step=check)
+    path = solve_load_path(strategy, EXAMPLE.solver.steps, max_cutbacks=0, on_step=check)
     assert path.converged
-    scale = EXAMPLE.radius
+    scale = RADIUS
     for rep in reports:
         assert rep.min_gap >= -1e-10 * scale
         assert rep.max_pressure <= 1e-10 * PAPER_E
@@ -50,7 +52,7 @@ def test_ends_lift_off_while_the_centre_stays_closed():
     assert path.converged
     state = problem.contact_state()
     x = problem.nodal_coordinates()[:, 0]
-    ends = np.isclose(np.abs(x), EXAMPLE.length / 2)
+    ends = np.isclose(np.abs(x), LENGTH / 2)
     assert np.all(state.gap[ends] > 0.05)
     assert np.all(state.active[~ends])
 

@@ -8,7 +8,7 @@ contact zone, so it measures the physical quantities rather than one node's
 value. The largest nodal pressure is checked against the same 2 % bound,
 since it is the quantity a user reads off a plot.
 
-Mesh and load (the ``HertzCylinder`` defaults): R = 1, E = 200, nu = 0.3,
+Mesh and load (the ``hertz_cylinder`` defaults): R = 1, E = 200, nu = 0.3,
 push 0.01 R, h_contact = 0.004 R, so a = 0.0785 R is spanned by ~20 elements
 (41 nodes in contact); 3869 unknowns. Measured errors: a -0.16 %,
 p0 (fit) +0.29 %, p0 (largest nodal) +0.32 %.
@@ -22,12 +22,8 @@ import pytest
 from mpi4py import MPI
 
 import fenics_contact  # noqa: F401  (before dolfinx)
-from fenics_contact.model.contact import ContactSettings
-from fenics_contact.scene.meshing import CONTACT_TAG, TOP_TAG, hertz_half_disk
-from fenics_contact.solvers import make_strategy
-from fenics_contact.solvers.diagnostics import SolverSettings
-from fenics_contact.solvers.stepping import solve_load_path
-from fenics_contact.verification.hertz import (
+from benchmarks import cases
+from fenics_contact.references.hertz import (
     fit_contact_profile,
     half_width,
     hertz_line_contact,
@@ -37,12 +33,18 @@ from fenics_contact.verification.hertz import (
     pressure_profile,
     relative_error,
 )
-from fenics_contact.verification.hertz_problem import HertzCylinder, measure_hertz
+from fenics_contact.references.measure import measure_hertz
+from fenics_contact.scene.build import build_mesh
+from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings
+from fenics_contact.solvers.stepping import solve_load_path
 
 #: Relative tolerance on a and p0. Measured errors on this mesh: 0.16 % (a), 0.29 %
 #: (p0 fit), 0.32 % (nodal peak). Using E instead of E' = E / (1 - nu^2) moves a and
 #: p0 by 4.6 %: the tolerance must reject that (checked below).
 TOLERANCE = 0.01
+#: The cylinder of ``cases.hertz_cylinder()``: radius and element size at contact (length).
+RADIUS, H_CONTACT = 1.0, 0.004
 
 
 # -- analytic formulas --------------------------------------------------------
@@ -89,8 +91,8 @@ def test_fit_recovers_an_exact_ellipse() -> None:
 @pytest.mark.mpi
 def test_half_disk_mesh_and_tags() -> None:
     R = 2.0
-    data = hertz_half_disk(MPI.COMM_WORLD, radius=R, h_contact=0.05, h_far=0.4)
-    domain = data.mesh
+    data = build_mesh(cases.hertz_cylinder(0.05, radius=R, h_far=0.4), MPI.COMM_WORLD)
+    domain = data.domain
     assert domain.geometry.dim == 2 and domain.topology.dim == 2
     x = domain.geometry.x[:, :2]
     assert np.all(x[:, 1] >= -1e-12) and np.all(x[:, 1] <= R + 1e-12)
@@ -99,8 +101,8 @@ def test_half_disk_mesh_and_tags() -> None:
     at_origin = int(np.sum(np.hypot(x[:, 0], x[:, 1]) < 1e-12) > 0)
     assert comm.allreduce(at_origin, op=MPI.SUM) >= 1  # the contact point is a vertex
     tags = data.facet_tags
-    for tag in (TOP_TAG, CONTACT_TAG):
-        assert comm.allreduce(tags.find(tag).size, op=MPI.SUM) > 0
+    for name in ("top", "contact"):
+        assert comm.allreduce(tags.find(data.names[name]).size, op=MPI.SUM) > 0
     n_cells = domain.topology.index_map(2).size_local
     assert np.all(data.cell_tags.values[data.cell_tags.indices < n_cells] == 1)
 
@@ -108,8 +110,8 @@ def test_half_disk_mesh_and_tags() -> None:
 # -- the finite element solution ------------------------------------------------
 @pytest.fixture(scope="module")
 def solved() -> tuple:
-    cylinder = HertzCylinder()
-    problem = cylinder.build(ContactSettings(r=1.0, relative=True, quadrature="nodal"))
+    cylinder = cases.hertz_cylinder(H_CONTACT, radius=RADIUS)
+    problem = cases.build(cylinder, 1.0, relative=True, quadrature="nodal")
     strategy = make_strategy("gnrm", problem, SolverSettings(atol=1e-10, max_iterations=30))
     path = solve_load_path(strategy, 3)
     return cylinder, problem, path
@@ -121,17 +123,17 @@ def test_load_path_converges(solved: tuple) -> None:
     assert path.converged
     assert all(step.iterations <= 10 for step in path.steps)
     state = problem.contact_state()
-    assert state.max_penetration < 1e-12 * cylinder.radius
+    assert state.max_penetration < 1e-12 * RADIUS
     # small load: a/R ~ 0.08, a spans ~20 contact elements
-    hertz = hertz_line_contact(state.contact_force, cylinder.radius, cylinder.E, cylinder.nu)
-    assert 0.05 < hertz.a / cylinder.radius < 0.1
-    assert hertz.a / cylinder.h_contact >= 15
+    hertz = hertz_line_contact(state.contact_force, RADIUS, cylinder.E, cylinder.nu)
+    assert 0.05 < hertz.a / RADIUS < 0.1
+    assert hertz.a / H_CONTACT >= 15
 
 
 @pytest.mark.mpi
 def test_hertz_half_width_and_peak_pressure(solved: tuple) -> None:
     cylinder, problem, _ = solved
-    c = measure_hertz(problem, cylinder)
+    c = measure_hertz(problem, RADIUS, cylinder.E, cylinder.nu)
     assert c.fit.n_contact >= 30
     assert abs(c.a_error) < TOLERANCE, f"half-width {c.fit.a} vs Hertz {c.hertz.a}"
     assert abs(c.p0_error) < TOLERANCE, f"peak (fit) {c.fit.p0} vs Hertz {c.hertz.p0}"
@@ -139,8 +141,8 @@ def test_hertz_half_width_and_peak_pressure(solved: tuple) -> None:
         f"peak (nodal) {c.fit.nodal_peak} vs Hertz {c.hertz.p0}"
     )
     # the likely wrong answer, Hertz with E in place of E' (nu = 0 makes E' = E), fails
-    wrong = hertz_line_contact(c.P, cylinder.radius, cylinder.E, 0.0)
+    wrong = hertz_line_contact(c.P, RADIUS, cylinder.E, 0.0)
     assert abs(relative_error(c.fit.a, wrong.a)) > 3 * TOLERANCE
     assert abs(relative_error(c.fit.p0, wrong.p0)) > 3 * TOLERANCE
     # the largest pressure sits at the centre of contact (within two elements)
-    assert abs(c.fit.x_peak) <= 2 * cylinder.h_contact
+    assert abs(c.fit.x_peak) <= 2 * H_CONTACT

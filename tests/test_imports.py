@@ -32,7 +32,7 @@ def test_module_list_is_complete():
     names = all_modules()
     files = sorted(ROOT.glob("fenics_contact/**/*.py"))
     assert len(names) == len([f for f in files if f.name != "__main__.py"]) - 1  # top __init__
-    for layer in ("model", "solvers", "scene", "output", "verification", "studies", "cli"):
+    for layer in ("model", "solvers", "scene", "output", "references", "sweeps", "cli"):
         assert f"fenics_contact.{layer}" in names
 
 

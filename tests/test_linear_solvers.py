@@ -13,20 +13,20 @@ import pytest
 from mpi4py import MPI
 
 import fenics_contact  # noqa: F401  (before dolfinx)
-from fenics_contact.model.contact import ContactSettings
+from benchmarks import cases
+from benchmarks.cases import cells_for_dofs
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.linear import LinearSolverSettings, rigid_body_modes
 from fenics_contact.solvers.predictor import Extrapolated
 from fenics_contact.solvers.stepping import solve_load_path
-from fenics_contact.verification.indentation import BlockIndentation, cells_for_dofs
 
 NEWTON = SolverSettings(atol=1e-12, rtol=1e-10, max_iterations=30)
 
 
 def solve(kind: str, method: str = "gnrm", comm: MPI.Comm = MPI.COMM_WORLD, n: int = 6) -> tuple:
-    problem = BlockIndentation(n=n, depth=0.03, candidate_radius=0.5).build(
-        ContactSettings(r=1.0), comm
+    problem = cases.build(
+        cases.block_indentation(n, depth=0.03, candidate_width=0.5), 1.0, comm=comm
     )
     strategy = make_strategy(method, problem, NEWTON)
     strategy.kernel.set_linear_solver(LinearSolverSettings(kind=kind))
@@ -40,7 +40,7 @@ def test_cells_for_dofs() -> None:
 
 
 def test_rigid_body_modes_are_orthonormal() -> None:
-    problem = BlockIndentation(n=4, candidate_radius=0.6).build(ContactSettings())
+    problem = cases.build(cases.block_indentation(4, candidate_width=0.6))
     basis = rigid_body_modes(problem.V).getVecs()
     gram = np.array([[a.dot(b) for b in basis] for a in basis])
     assert gram.shape == (6, 6)
@@ -69,7 +69,7 @@ def test_kernel_accounts_add_up() -> None:
     assert t.residuals == path.iterations + len(path.steps)
     assert min(t.compile_s, t.residual_s, t.jacobian_s, t.setup_s, t.solve_s) > 0
     # the totals are sums of the disjoint phase accounts (a bookkeeping identity;
-    # how the phases compare with wall time is measured in benchmarks/hertz2d.py)
+    # how the phases compare with wall time is measured in benchmarks/validation/hertz2d.py)
     accounted = t.residual_s + t.jacobian_s + t.setup_s + t.solve_s
     assert t.assembly_s + t.linear_s == pytest.approx(accounted, rel=1e-12)
 
@@ -123,7 +123,7 @@ def test_solver_options_leave_with_their_kernel(release: str) -> None:
 
     from fenics_contact.solvers.condensed import kernel_for
 
-    problem = BlockIndentation(n=4).build(ContactSettings(r=1.0), MPI.COMM_WORLD)
+    problem = cases.build(cases.block_indentation(4), 1.0, comm=MPI.COMM_WORLD)
     kernel = kernel_for(problem.augmented_system(), LinearSolverSettings(kind="iterative"))
     prefix = kernel._prefix
     mine = [k for k in PETSc.Options().getAll() if k.startswith(prefix)]

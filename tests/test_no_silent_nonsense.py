@@ -126,12 +126,12 @@ def test_tiny_r_gnrm_does_not_report_convergence_with_a_gap():
     every r); with that test disabled (gap_tol = 1) it stops at a gap of
     7.6e-4, which is what "converged" used to mean.
     """
-    from fenics_contact.verification.hertz_problem import HertzCylinder
+    from benchmarks import cases
 
-    cylinder = HertzCylinder()
+    cylinder = cases.hertz_cylinder()
     results = {}
     for gap_tol in (1e-6, 1.0):
-        problem = cylinder.build(ContactSettings(r=1e-8, relative=True))
+        problem = cases.build(cylinder, 1e-8, relative=True)
         strategy = make_strategy("gnrm", problem, SolverSettings(rtol=1e-10, gap_tol=gap_tol))
         path = solve_load_path(strategy, 2)
         results[gap_tol] = (path.status, problem.contact_state(), problem.surface.h)
@@ -218,12 +218,13 @@ def test_prescribed_displacements_must_hold_at_convergence():
 
     The Dirichlet rows hold x - x_D (length), so the residual norm alone cannot tell.
     """
+    from benchmarks import cases
     from fenics_contact.solvers.diagnostics import prescribed_admissibility
-    from fenics_contact.studies.stability import StabilityCase, run_case
-    from fenics_contact.verification.two_body_examples import TwoCylinders
+    from fenics_contact.sweeps.stability import StabilityCase, run_case
 
-    scene = TwoCylinders()
-    problem = scene.build(ContactSettings(r=1.0))
+    push = 0.02
+    scene = cases.two_cylinders(push=push)
+    problem = cases.build(scene, 1.0)
     check = prescribed_admissibility(problem, SolverSettings())
     assert check() is None and problem.prescribed_mismatch() == 0.0
     problem.set_load(0.5)  # push 0.02: the top is 0.01 from its prescribed value
@@ -238,4 +239,4 @@ def test_prescribed_displacements_must_hold_at_convergence():
         # measured: diverged at the first iteration of step 1 (formerly converged, 0 iterations)
         assert record.status != "converged" and record.iterations >= 1, (method, record.status)
     auto = run_case(case, "auto")
-    assert auto.converged and auto.max_abs_u == pytest.approx(scene.push, rel=1e-12)
+    assert auto.converged and auto.max_abs_u == pytest.approx(push, rel=1e-12)

@@ -15,20 +15,15 @@ import pytest
 
 from mpi4py import MPI
 
-from fenics_contact.model.contact import ContactSettings
-from fenics_contact.model.friction import SLIP, STICK, FrictionSettings
-from fenics_contact.model.materials import material
-from fenics_contact.model.problem import (
-    Body,
-    PathDisplacement,
-    PrescribedDisplacement,
-    two_body_problem,
-)
-from fenics_contact.scene import two_body_meshing as tbm
+from benchmarks import cases
+from benchmarks.cases import PRESS_SLIDE_PAIR
+from fenics_contact import build_problem, scene_from_data
+from fenics_contact.model.friction import SLIP, STICK
+from fenics_contact.scene.build import build_mesh, build_two_body_problem
+from fenics_contact.scene.variants import with_contact_settings
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.stepping import solve_load_path
-from fenics_contact.verification.two_body_examples import PRESS_SLIDE_PAIR, SlidingBlocks
 
 MU = 0.3
 STEPS = 10
@@ -42,22 +37,22 @@ SERIAL_TANGENTIAL_FORCE = 0.4773198325213958
 
 
 def blocks(mu: float | None = MU, r: float = 1.0):
-    """The sliding blocks and their facet tags; ``mu = None``: frictionless."""
-    scene = SlidingBlocks(mu=mu, path=PATH)
-    md = scene.mesh()
-    return scene.problem(md, ContactSettings(r=r)), md.facet_tags
+    """The sliding blocks and their mesh (with the facet tags); ``mu = None``: frictionless."""
+    scene = with_contact_settings(cases.sliding_blocks(mu, path=PATH), r, relative=True)
+    body = build_mesh(scene)
+    return build_two_body_problem(scene, body), body
 
 
 def solve(method: str = "gnrm", r: float = 1.0, mu: float | None = MU, max_iterations=50):
     """Run the load path; returns the problem, facet tags, record and nodal states per step."""
-    problem, ft = blocks(mu, r)
+    problem, body = blocks(mu, r)
     strategy = make_strategy(
         method, problem, SolverSettings(atol=1e-8, rtol=1e-10, max_iterations=max_iterations)
     )
     states = []
     run = solve_load_path(strategy, STEPS, max_cutbacks=0,
                           on_step=lambda _: states.append(problem.contact_state()))
-    return problem, ft, run, states
+    return problem, body, run, states
 
 
 @pytest.fixture(scope="module")
@@ -149,9 +144,9 @@ def test_gnrm_answer_does_not_depend_on_r(gnrm_run):
 @pytest.mark.mpi
 def test_target_reaction_equals_striker_reaction(gnrm_run):
     """Friction reaches the target: its contact force balances the striker's support."""
-    problem, ft, _, _ = gnrm_run
-    top = problem.reaction(ft.find(tbm.LOAD_TAG))
-    bottom = problem.reaction(ft.find(tbm.SUPPORT_TAG))
+    problem, body, _, _ = gnrm_run
+    top = problem.reaction(body.facet_tags.find(body.names["top"]))
+    bottom = problem.reaction(body.facet_tags.find(body.names["bottom"]))
     scale = SERIAL_NORMAL_FORCE
     np.testing.assert_allclose(top + bottom, 0.0, atol=1e-10 * scale)
     assert top[0] > 0.25 * scale  # the support drags the striker against friction
@@ -195,7 +190,8 @@ def test_scene_pair_takes_mu(tmp_path):
     plain.write_text((root / "scenes" / "ironing.toml").read_text().replace(
         "[solver]", '[output]\nfields = ["slip"]\n[solver]').replace("../meshes",
                                                                      str(root / "meshes")))
-    with pytest.raises(SceneError, match=r"friction fields need \[\[pair\]\] mu"):
+    with pytest.raises(SceneError,
+                       match=r"friction fields need \[\[pair\]\] or \[\[obstacle\]\] mu"):
         load_scene(plain)
     assert dataclasses.replace(scene.pairs[0], mu=None).mu is None
 
@@ -243,18 +239,22 @@ def test_hemispheres_slide_in_3d():
     component leaves that tangential multiplier component undetermined
     (singular Jacobian). Slow only through the first FFCx compilation.
     """
-    md = tbm.two_hemispheres(MPI.COMM_WORLD, h_contact=0.08)
-    ft = md.facet_tags
-    law = material("linear", 200.0, 0.3)
-    path = ((0.0, 0.0, 0.0, 0.0), (0.5, 0.0, 0.0, -0.02), (1.0, 0.0, 0.02, -0.02))
-    problem = two_body_problem(
-        md.mesh, md.cell_tags,
-        [Body("upper", tbm.STRIKER_TAG, law), Body("lower", tbm.TARGET_TAG, law)],
-        ft.find(tbm.STRIKER_FACE_TAG), ft.find(tbm.TARGET_FACE_TAG), ContactSettings(r=1.0),
-        friction=FrictionSettings(MU),
-        prescribed=[PathDisplacement(ft.find(tbm.LOAD_TAG), (None, None, None), path=path),
-                    PrescribedDisplacement(ft.find(tbm.SUPPORT_TAG), (0.0, 0.0, 0.0))],
-    )
+    root = Path(__file__).resolve().parents[1]
+    law = {"law": "linear", "E": 200.0, "nu": 0.3}
+    scene = scene_from_data({
+        "scene": {"name": "hemispheres-slide", "dimension": 3},
+        "mesh": {"file": str(root / "meshes" / "two_hemispheres.geo"),
+                 "parameters": {"h_contact": 0.08}},
+        "body": [{"name": "upper", "tag": "striker", **law},
+                 {"name": "lower", "tag": "target", **law}],
+        "pair": [{"name": "pair", "striker": "striker_cap", "target": "target_cap",
+                  "r": 1.0, "mu": MU}],
+        "dirichlet": [{"tag": "top", "path": [[0.0, 0.0, 0.0, 0.0], [0.5, 0.0, 0.0, -0.02],
+                                              [1.0, 0.0, 0.02, -0.02]]},
+                      {"tag": "bottom", "value": [0.0, 0.0, 0.0]}],
+        "solver": {"steps": 8},
+    }, root / "scenes" / "hemispheres_slide.toml")
+    problem = build_problem(scene, MPI.COMM_WORLD)
     strategy = make_strategy("gnrm", problem, SolverSettings(atol=1e-8, rtol=1e-10))
     run = solve_load_path(strategy, 8, max_cutbacks=0)
     assert run.converged

@@ -11,13 +11,13 @@ import math
 import numpy as np
 import pytest
 
-from fenics_contact.cli import main
+from benchmarks.research.paper import PAPER_E, PAPER_NU, PAPER_PENALTY_U
+from benchmarks.research.paper_ex1 import StrikerOnFacet, corner_displacement
+from benchmarks.research.study import main, subjects
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings, Status
 from fenics_contact.solvers.stepping import solve_load_path
-from fenics_contact.verification.examples import EXAMPLES, StrikerOnFacet, WedgeOnCorner
-from fenics_contact.verification.paper import PAPER_E, PAPER_NU, PAPER_PENALTY_U
 
 EX1 = StrikerOnFacet()
 H = EX1.h
@@ -65,7 +65,7 @@ def test_gnrm_finds_u_equal_2h_in_two_newton_steps(r):
     assert path.converged
     assert path.iterations == 2
     assert len(path.steps[0].residuals[0]) == 3
-    assert EX1.corner_displacement(problem) == pytest.approx(2 * H, abs=1e-12)
+    assert corner_displacement(problem) == pytest.approx(2 * H, abs=1e-12)
     state = problem.contact_state()
     assert state.max_penetration < 1e-12
     assert state.contact_force == pytest.approx(60.828932, abs=1e-5)
@@ -76,11 +76,11 @@ def test_gnrm_and_penalty_on_any_number_of_ranks():
     """One cell: on two ranks one of them holds no contact element."""
     path, problem = solve("gnrm", 100.0)
     assert path.converged and path.iterations == 2
-    assert EX1.corner_displacement(problem) == pytest.approx(2 * H, abs=1e-12)
+    assert corner_displacement(problem) == pytest.approx(2 * H, abs=1e-12)
     assert problem.contact_state().contact_force == pytest.approx(60.828932, abs=1e-5)
     path, problem = solve("penalty", 100.0)
     assert path.converged and path.iterations == 4
-    assert EX1.corner_displacement(problem) == pytest.approx(NUMPY_PENALTY_U[100.0], abs=1e-11)
+    assert corner_displacement(problem) == pytest.approx(NUMPY_PENALTY_U[100.0], abs=1e-11)
 
 
 #: Penalty displacement with 2 x 2 Gauss energy, from the numpy model of
@@ -93,7 +93,7 @@ NUMPY_PENALTY_U = {100.0: -0.0987501546771874, 1000.0: -0.38726857774465984}
 def test_penalty_displacement_is_the_papers(r):
     path, problem = solve("penalty", r)
     assert path.converged
-    u = EX1.corner_displacement(problem)
+    u = corner_displacement(problem)
     assert u == pytest.approx(NUMPY_PENALTY_U[r], abs=1e-11)
     # the paper prints three digits: ours rounds to them exactly
     assert float(f"{u:.3g}") == PAPER_PENALTY_U[r]
@@ -134,7 +134,7 @@ def test_gnrm_diverges_above_the_critical_r():
     problem.set_load(1.0)
     strategy.kernel.assemble_residual()
     assert strategy.kernel.newton_step()
-    assert EX1.corner_displacement(problem) == pytest.approx(2 * H, abs=1e-12)
+    assert corner_displacement(problem) == pytest.approx(2 * H, abs=1e-12)
     assert problem.lam.x.array[0] == pytest.approx(4 * H * (K0 - 1e4 * H**2), rel=1e-10)
     assert solve("gnrm", 1e4)[0].status == Status.DIVERGED
     assert solve("gnrm", 0.98 * r_star)[0].converged
@@ -146,8 +146,8 @@ def test_bad_target_or_striker_is_refused_before_any_work():
 
     from mpi4py import MPI
 
+    from benchmarks.research.striker import StrikerOnFacetProblem
     from fenics_contact.model.materials import SaintVenantKirchhoff
-    from fenics_contact.verification.striker import StrikerOnFacetProblem
 
     domain = mesh.create_unit_square(MPI.COMM_WORLD, 1, 1, mesh.CellType.quadrilateral)
     top = mesh.locate_entities_boundary(domain, 1, lambda x: np.isclose(x[1], 1.0))
@@ -162,14 +162,19 @@ def test_bad_target_or_striker_is_refused_before_any_work():
         StrikerOnFacetProblem(domain, law, top, (0.5, 1.0), (0.0, H, 0.0), settings)
 
 
-def test_the_wedge_analog_keeps_its_name():
-    assert EXAMPLES["paper-ex1"] is StrikerOnFacet
-    assert EXAMPLES["paper-ex1-wedge"] is WedgeOnCorner
+def test_the_paper_examples_keep_their_names():
+    """Example 1 is the one custom problem; its wedge analog and Example 2 are scenes."""
+    from fenics_contact import Scene
+
+    known = subjects()
+    assert isinstance(known["paper-ex1"].case, StrikerOnFacet)
+    assert isinstance(known["paper-ex1-wedge"].case, Scene)
+    assert isinstance(known["paper-ex2"].case, Scene)
 
 
 def test_study_prints_ours_beside_the_paper_and_the_wedge(tmp_path, capsys):
     code = main(
-        ["study", "paper-ex1", "--methods", "gnrm", "--r", "100,10000", "--beside",
+        ["paper-ex1", "--methods", "gnrm", "--r", "100,10000", "--beside",
          "paper-ex1-wedge", "--out", str(tmp_path)]
     )
     assert code == 0

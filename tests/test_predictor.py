@@ -13,19 +13,17 @@ import numpy as np
 import pytest
 
 import fenics_contact  # noqa: F401  (before dolfinx)
-from fenics_contact.model.contact import ContactSettings
+from benchmarks import cases
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.predictor import Extrapolated
 from fenics_contact.solvers.stepping import solve_load_path
-from fenics_contact.verification.examples import BarOnCradle
-from fenics_contact.verification.hertz_problem import HertzCylinder
 
-CYLINDER = HertzCylinder(push=0.02, h_contact=0.008, fine_radius=0.22)
+CYLINDER = cases.hertz_cylinder(0.008, push=0.02, fine_radius=0.22)
 
 
 def hertz_path(r: float, predictor: bool) -> tuple:
-    problem = CYLINDER.build(ContactSettings(r=r, relative=True, quadrature="nodal"))
+    problem = cases.build(CYLINDER, r, relative=True, quadrature="nodal")
     strategy = make_strategy("gnrm", problem, SolverSettings(atol=1e-8))
     if predictor:
         strategy = Extrapolated(strategy)
@@ -56,10 +54,10 @@ def test_predictor_changes_the_work_not_the_answer() -> None:
 
 
 def test_predictor_survives_cutbacks_and_outside_changes() -> None:
-    example = BarOnCradle()
-    reference = example.build(ContactSettings(r=1.0))
-    solve_load_path(make_strategy("gnrm", reference, SolverSettings()), example.steps)
-    problem = example.build(ContactSettings(r=1.0))
+    scene = cases.bar_on_cradle()
+    reference = cases.build(scene, 1.0)
+    solve_load_path(make_strategy("gnrm", reference, SolverSettings()), scene.solver.steps)
+    problem = cases.build(scene, 1.0)
     strategy = Extrapolated(make_strategy("gnrm", problem, SolverSettings(max_iterations=5)))
     path = solve_load_path(strategy, 1, max_cutbacks=6)
     assert path.converged and path.steps[0].cutbacks >= 1

@@ -157,21 +157,21 @@ def test_failing_run_exits_nonzero_and_keeps_finished_steps(tmp_path, capsys):
 
 
 def test_demo_scene_files_describe_the_demo_problems(tmp_path):
-    """scenes/paper_ex2.toml and the BarOnCradle builder of the demo give one answer."""
-    from fenics_contact.model.contact import ContactSettings
+    """scenes/paper_ex2.toml and the laboratory's bar_on_cradle case give one answer."""
+    from benchmarks import cases
     from fenics_contact.solvers import make_strategy
     from fenics_contact.solvers.diagnostics import SolverSettings
     from fenics_contact.solvers.stepping import solve_load_path
-    from fenics_contact.verification.examples import BarOnCradle
 
     text = (SCENES / "paper_ex2.toml").read_text().replace(
         "[solver]", '[solver]\npredictor = "previous"'
     )
     (tmp_path / "ex2.toml").write_text(text)
     outcome = run_scene(load_scene(tmp_path / "ex2.toml"), tmp_path, pictures=False)
-    example = BarOnCradle()
-    problem = example.build(ContactSettings(r=100.0, relative=False))
-    path = solve_load_path(make_strategy("gnrm", problem, SolverSettings()), example.steps)
+    example = cases.bar_on_cradle()
+    problem = cases.build(example, 100.0, relative=False)
+    path = solve_load_path(make_strategy("gnrm", problem, SolverSettings()),
+                           example.solver.steps)
     assert [s.iterations for s in outcome.path.steps] == [s.iterations for s in path.steps]
     assert outcome.path.steps[-1].contact_force == pytest.approx(
         path.steps[-1].contact_force, rel=1e-10

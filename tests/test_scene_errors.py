@@ -531,14 +531,10 @@ def test_floating_body_of_a_pair_is_named(tmp_path):
 def _overlapping(tmp_path, depth: float) -> Path:
     """The blocks with the upper one ``depth`` lower: its face that far inside the lower one."""
     geo = (MESHES / "block_on_block.geo").read_text()
-    for old in ("Point(5) = {0, H, 0}; Point(6) = {W, H, 0};",
-                "Point(7) = {W, 2 * H, 0}; Point(8) = {0, 2 * H, 0};"):
-        assert old in geo
-    geo = geo.replace("Point(5) = {0, H, 0}; Point(6) = {W, H, 0};",
-                      f"Point(5) = {{0, H - {depth}, 0}}; Point(6) = {{W, H - {depth}, 0}};")
-    geo = geo.replace("Point(7) = {W, 2 * H, 0}; Point(8) = {0, 2 * H, 0};",
-                      f"Point(7) = {{W, 2 * H - {depth}, 0}}; "
-                      f"Point(8) = {{0, 2 * H - {depth}, 0}};")
+    upper = ("Point(5) = {x0, H, 0}; Point(6) = {x0 + Wu, H, 0}; Point(7) = {x0 + Wu, 2 * H, 0};\n"
+             "Point(8) = {x0, 2 * H, 0};")
+    assert upper in geo
+    geo = geo.replace(upper, upper.replace("H, 0}", f"H - {depth}, 0}}"))
     (tmp_path / "overlap.geo").write_text(geo)
     return _blocks(tmp_path, BLOCKS, tmp_path / "overlap.geo")
 

@@ -6,20 +6,19 @@ import numpy as np
 
 from mpi4py import MPI
 
-from fenics_contact.model.contact import ContactSettings
+from benchmarks import cases
 from fenics_contact.output.io import write_json
 from fenics_contact.output.xdmf import StepWriter
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings, Status
 from fenics_contact.solvers.stepping import solve_load_path
-from fenics_contact.verification.examples import BarOnCradle
 
 
 def test_one_big_step_is_cut_back_and_reaches_the_ten_step_answer():
-    example = BarOnCradle()
-    reference = example.build(ContactSettings(r=1.0))
-    solve_load_path(make_strategy("gnrm", reference, SolverSettings()), example.steps)
-    problem = example.build(ContactSettings(r=1.0))
+    scene = cases.bar_on_cradle()
+    reference = cases.build(scene, 1.0)
+    solve_load_path(make_strategy("gnrm", reference, SolverSettings()), scene.solver.steps)
+    problem = cases.build(scene, 1.0)
     # The whole load at once needs 7 iterations: 5 forces cut-backs.
     strategy = make_strategy("gnrm", problem, SolverSettings(max_iterations=5))
     path = solve_load_path(strategy, 1, max_cutbacks=6)
@@ -30,8 +29,8 @@ def test_one_big_step_is_cut_back_and_reaches_the_ten_step_answer():
 
 
 def test_failed_path_reports_status_and_keeps_completed_steps(tmp_path):
-    example = BarOnCradle()
-    problem = example.build(ContactSettings(r=10.0, relative=False))
+    scene = cases.bar_on_cradle()
+    problem = cases.build(scene, 10.0, relative=False)
     # Simultaneous Uzawa at r = 10 needs about 35 iterations a step until all
     # seven nodes close at step 6, which takes several hundred.
     strategy = make_strategy("sua", problem, SolverSettings(max_iterations=100))
@@ -43,7 +42,7 @@ def test_failed_path_reports_status_and_keeps_completed_steps(tmp_path):
         written.append(step.step)
         write_json(tmp_path / "steps.json", written)
 
-    path = solve_load_path(strategy, example.steps, max_cutbacks=0, on_step=keep)
+    path = solve_load_path(strategy, scene.solver.steps, max_cutbacks=0, on_step=keep)
     writer.close()
     assert path.status == Status.MAX_ITERATIONS
     assert len(path.steps) == len(written) + 1

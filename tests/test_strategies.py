@@ -1,6 +1,7 @@
 """Each strategy against GNRM and the exact answer; real cycling and divergence."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -8,6 +9,8 @@ from dolfinx import mesh
 
 from mpi4py import MPI
 
+from benchmarks.cases import bar_on_cradle, build, wedge_on_corner
+from benchmarks.research.paper_ex1 import corner_displacement
 from fenics_contact.cli import main
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import SaintVenantKirchhoff
@@ -16,24 +19,25 @@ from fenics_contact.model.problem import SurfaceTraction, one_body_problem
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings, Status
 from fenics_contact.solvers.stepping import solve_load_path
-from fenics_contact.verification.examples import BarOnCradle, WedgeOnCorner
 
-EX1 = WedgeOnCorner()
-EX2 = BarOnCradle()
+EX1 = wedge_on_corner()
+EXACT_U = -0.5  # the wedge's slope 2 times its slide -0.25
+EX2 = bar_on_cradle()
+SCENES = Path(__file__).resolve().parents[1] / "scenes"
 
 
 def corner_u(method, r, max_iterations=500):
-    problem = EX1.build(ContactSettings(r=r, relative=False))
+    problem = build(EX1, r, relative=False)
     strategy = make_strategy(method, problem, SolverSettings(max_iterations=max_iterations))
-    path = solve_load_path(strategy, EX1.steps, max_cutbacks=0)
-    return path, EX1.corner_displacement(problem)
+    path = solve_load_path(strategy, EX1.solver.steps, max_cutbacks=0)
+    return path, corner_displacement(problem)
 
 
 @pytest.mark.parametrize("method", ["gnrm", "sua", "nua"])
 def test_augmented_lagrangian_strategies_hit_the_exact_answer(method):
     path, u = corner_u(method, 1000.0)
     assert path.converged
-    assert u == pytest.approx(EX1.exact_u, abs=1e-9)
+    assert u == pytest.approx(EXACT_U, abs=1e-9)
 
 
 def test_gnrm_takes_two_iterations_whatever_r():
@@ -43,18 +47,18 @@ def test_gnrm_takes_two_iterations_whatever_r():
 
 
 def test_penalty_error_falls_like_one_over_r_on_example_1():
-    errors = [abs(corner_u("penalty", r)[1] - EX1.exact_u) for r in (1e4, 1e5, 1e6)]
+    errors = [abs(corner_u("penalty", r)[1] - EXACT_U) for r in (1e4, 1e5, 1e6)]
     for k in range(2):
         assert errors[k] / errors[k + 1] == pytest.approx(10.0, rel=0.2)
 
 
 @pytest.mark.parametrize(("method", "r"), [("nua", 1000.0), ("penalty", 1e5)])
 def test_example_2_strategies_agree_with_gnrm(method, r):
-    reference = EX2.build(ContactSettings(r=r, relative=False))
-    solve_load_path(make_strategy("gnrm", reference, SolverSettings()), EX2.steps)
-    problem = EX2.build(ContactSettings(r=r, relative=False))
+    reference = build(EX2, r, relative=False)
+    solve_load_path(make_strategy("gnrm", reference, SolverSettings()), EX2.solver.steps)
+    problem = build(EX2, r, relative=False)
     path = solve_load_path(
-        make_strategy(method, problem, SolverSettings(max_iterations=500)), EX2.steps,
+        make_strategy(method, problem, SolverSettings(max_iterations=500)), EX2.solver.steps,
         max_cutbacks=0,
     )
     assert path.converged
@@ -65,9 +69,9 @@ def test_example_2_strategies_agree_with_gnrm(method, r):
 
 
 def test_simultaneous_uzawa_cycles_on_example_2_at_large_r():
-    problem = EX2.build(ContactSettings(r=1000.0, relative=False))
+    problem = build(EX2, 1000.0, relative=False)
     strategy = make_strategy("sua", problem, SolverSettings(max_iterations=500))
-    result = solve_load_path(strategy, EX2.steps, max_cutbacks=0)
+    result = solve_load_path(strategy, EX2.solver.steps, max_cutbacks=0)
     assert result.status == Status.CYCLING
     assert result.steps[0].iterations < 50
 
@@ -90,7 +94,8 @@ def test_singular_system_is_reported_as_divergence_not_an_exception():
 
 def test_study_command_writes_the_table_json_csv_and_plots(tmp_path, capsys):
     code = main(
-        ["study", "paper-ex1", "--methods", "penalty,gnrm", "--r", "10,1000", "--out",
+        ["study", str(SCENES / "paper_ex1.toml"), "--methods", "penalty,gnrm", "--r", "10,1000",
+         "--out",
          str(tmp_path)]
     )
     assert code == 0
@@ -110,6 +115,6 @@ def test_study_command_writes_the_table_json_csv_and_plots(tmp_path, capsys):
 
 def test_study_command_rejects_bad_r_before_any_work(capsys):
     with pytest.raises(SystemExit) as exc:
-        main(["study", "paper-ex1", "--r", "10,-1"])
+        main(["study", str(SCENES / "paper_ex1.toml"), "--r", "10,-1"])
     assert exc.value.code == 2
     assert "every r must be > 0" in capsys.readouterr().err

@@ -1,11 +1,22 @@
-"""The tradeoff and stability commands on tiny grids: files and columns."""
+"""The tradeoff and stability sweeps on tiny grids: files and columns.
+
+``fenics-contact tradeoff|stability`` take scene files; the project's own
+grids (``benchmarks/research/tradeoff.py``, ``benchmarks/robustness/
+stability_grid.py``) run the same machinery on the lab's scenes.
+"""
 
 import csv
 import json
+from pathlib import Path
 
 import pytest
 
+from benchmarks.research import tradeoff as lab_tradeoff
+from benchmarks.robustness.stability_grid import full_grid
 from fenics_contact.cli import main
+from fenics_contact.cli.stability import run_cases
+
+SCENES = Path(__file__).resolve().parents[1] / "scenes"
 
 
 def read_csv(path):
@@ -13,9 +24,9 @@ def read_csv(path):
         return list(csv.DictReader(f))
 
 
-def test_tradeoff_command_writes_json_csv_table_and_plot(tmp_path):
-    code = main(["tradeoff", "--scene", "bar", "--methods", "gnrm,auto", "--r", "1,1e10",
-                 "--meshes", "1", "--repeats", "1", "--out", str(tmp_path)])
+def test_tradeoff_command_on_a_scene_writes_json_csv_table_and_plot(tmp_path):
+    code = main(["tradeoff", str(SCENES / "paper_ex2.toml"), "--name", "bar", "--methods",
+                 "gnrm,auto", "--r", "1,1e10", "--repeats", "1", "--out", str(tmp_path)])
     assert code == 0
     rows = read_csv(tmp_path / "tradeoff.csv")
     columns = {"scene", "mesh", "displacement_dofs", "method", "r_relative", "status", "iterations",
@@ -27,15 +38,22 @@ def test_tradeoff_command_writes_json_csv_table_and_plot(tmp_path):
     assert status[("auto", 1e10)] == "converged" and status[("gnrm", 1e10)] != "converged"
     assert any(r["pareto_u"] == "True" for r in rows)
     assert len(json.loads((tmp_path / "tradeoff.json").read_text())) == 4
-    assert "| bar | 6x2 | Auto |" in (tmp_path / "table.md").read_text()
+    assert "| bar | paper_ex2 | Auto |" in (tmp_path / "table.md").read_text()
     assert (tmp_path / "tradeoff.png").stat().st_size > 10_000
 
 
-def test_stability_command_writes_csv_plot_and_step_records(tmp_path):
-    code = main(["stability", "--cases", "bar-r1e12,bar-no-contact", "--methods", "gnrm,auto",
-                 "--out", str(tmp_path)])
+def test_stability_command_on_a_scene_and_the_lab_grid(tmp_path):
+    code = main(["stability", str(SCENES / "paper_ex2.toml"), "--r", "1e12", "--methods",
+                 "gnrm,auto", "--out", str(tmp_path / "scene")])
     assert code == 0
-    rows = read_csv(tmp_path / "stability.csv")
+    rows = read_csv(tmp_path / "scene" / "stability.csv")
+    status = {(r["case"], r["method"]): r["status"] for r in rows}
+    assert status == {("paper-ex2-r1e+12", "gnrm"): "diverged",
+                      ("paper-ex2-r1e+12", "auto"): "converged"}
+    code = run_cases(full_grid(), ["--cases", "bar-r1e12,bar-no-contact", "--methods",
+                                   "gnrm,auto", "--out", str(tmp_path / "grid")], tmp_path)
+    assert code == 0
+    rows = read_csv(tmp_path / "grid" / "stability.csv")
     columns = {"case", "group", "method", "status", "iterations", "steps_completed",
                "max_penetration", "contact_force", "max_abs_u", "atol", "switches"}
     assert columns <= set(rows[0])
@@ -46,13 +64,14 @@ def test_stability_command_writes_csv_plot_and_step_records(tmp_path):
     }
     assert all("nan" not in v.lower() and "inf" not in v.lower()
                for r in rows for v in r.values())
-    assert (tmp_path / "stability.png").stat().st_size > 5_000
-    assert len(list((tmp_path / "cases").glob("*.json"))) == 4
+    assert (tmp_path / "grid" / "stability.png").stat().st_size > 5_000
+    assert len(list((tmp_path / "grid" / "cases").glob("*.json"))) == 4
 
 
 def test_tradeoff_friction_group_scores_the_coulomb_law(tmp_path):
-    code = main(["tradeoff", "--scene", "friction", "--mu", "0.3", "--methods", "penalty,gnrm",
-                 "--r", "1,1e4", "--meshes", "1", "--repeats", "1", "--out", str(tmp_path)])
+    code = lab_tradeoff.main(["--scene", "friction", "--mu", "0.3", "--methods", "penalty,gnrm",
+                              "--r", "1,1e4", "--meshes", "1", "--repeats", "1",
+                              "--out", str(tmp_path)])
     assert code == 0
     rows = {(r["method"], float(r["r_relative"])): r for r in read_csv(tmp_path / "tradeoff.csv")}
     assert len(rows) == 4
@@ -81,11 +100,11 @@ def test_stability_two_body_friction_records_coulomb_ratio_and_reference(tmp_pat
     round-off's).
     """
     with pytest.raises(SystemExit):
-        main(["stability", "--help"])
+        run_cases(full_grid(), ["--help"], tmp_path)
     assert "friction-r,two-body-friction,two-body-friction-r)" in "".join(
         capsys.readouterr().out.split())
-    code = main(["stability", "--cases", "blocks-mu0.3,blocks-r1e12", "--methods", "gnrm,auto",
-                 "--out", str(tmp_path)])
+    code = run_cases(full_grid(), ["--cases", "blocks-mu0.3,blocks-r1e12", "--methods",
+                                   "gnrm,auto", "--out", str(tmp_path)], tmp_path)
     assert code == 0
     rows = {(r["case"], r["method"]): r for r in read_csv(tmp_path / "stability.csv")}
     assert {"mu", "tangential_force", "ft_ratio", "reference", "reference_deviation",

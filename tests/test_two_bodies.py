@@ -4,29 +4,20 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from dolfinx.mesh import MeshTags
 
 from mpi4py import MPI
 
+from benchmarks import cases
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import material
-from fenics_contact.model.problem import (
-    Body,
-    ContactProblem,
-    PrescribedDisplacement,
-    two_body_problem,
-)
+from fenics_contact.model.problem import Body, ContactProblem, two_body_problem
 from fenics_contact.model.search import SurfaceSearch
-from fenics_contact.scene import two_body_meshing as tbm
+from fenics_contact.references.hertz import fit_contact_profile, half_width, peak_pressure
+from fenics_contact.scene.build import BodyMesh, build_mesh, build_two_body_problem
+from fenics_contact.scene.spec import Scene
+from fenics_contact.scene.variants import with_contact_settings
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings
-from fenics_contact.verification.hertz import fit_contact_profile, half_width, peak_pressure
-from fenics_contact.verification.two_body_examples import (
-    BlockOnBlock,
-    TwoCylinders,
-    hemispheres_fixed,
-    linear_pair,
-)
 
 
 # -- search --------------------------------------------------------------------------
@@ -77,9 +68,19 @@ def test_search_matches_brute_force() -> None:
 
 
 # -- problems --------------------------------------------------------------------------
-def _blocks(n_upper: int, n_lower: int, r: float = 1.0) -> tuple[ContactProblem, MeshTags]:
-    md = BlockOnBlock(n_upper, n_lower).mesh()
-    return linear_pair(md, ContactSettings(r=r), BlockOnBlock.FIXED), md.facet_tags
+def _with_mesh(scene: Scene, r: float = 1.0) -> tuple[ContactProblem, BodyMesh]:
+    """The scene's problem at r (relative to E/h) and its mesh, for the facet tags."""
+    scene = with_contact_settings(scene, r, relative=True)
+    body = build_mesh(scene)
+    return build_two_body_problem(scene, body), body
+
+
+def _facets(body: BodyMesh, name: str) -> np.ndarray:
+    return body.facet_tags.find(body.names[name])
+
+
+def _blocks(n_upper: int, n_lower: int, r: float = 1.0) -> tuple[ContactProblem, BodyMesh]:
+    return _with_mesh(cases.block_on_block(n_upper, n_lower), r)
 
 
 def _solve(problem, method: str, steps: int) -> list:
@@ -107,11 +108,11 @@ def test_patch_matching_uniform_pressure() -> None:
 
 @pytest.mark.mpi
 def test_patch_non_matching_force_balance() -> None:
-    problem, ft = _blocks(8, 11)
+    problem, body = _blocks(8, 11)
     _solve(problem, "gnrm", 2)
     state = problem.contact_state()
-    top = problem.reaction(ft.find(tbm.LOAD_TAG))[1]
-    bottom = problem.reaction(ft.find(tbm.SUPPORT_TAG))[1]
+    top = problem.reaction(_facets(body, "top"))[1]
+    bottom = problem.reaction(_facets(body, "bottom"))[1]
     # the load balances through the interface: top and bottom reactions to 1e-10
     assert abs(top + bottom) <= 1e-10 * state.contact_force
     # the normal-force magnitude differs from the vertical load by the tilt of the
@@ -147,7 +148,7 @@ def test_strategies_on_two_bodies(method: str, r: float) -> None:
 
 
 def _cylinders(h: float, r: float) -> ContactProblem:
-    return TwoCylinders(h_contact=h, push=0.02).build(ContactSettings(r=r))
+    return cases.build(cases.two_cylinders(h, push=0.02), r)
 
 
 @pytest.fixture(scope="module")
@@ -205,19 +206,7 @@ def _order(residuals: list[float], floor: float = 1e-11) -> float:
 
 def test_ironing_short() -> None:
     """Press, then slide 1.2 radii in 8 steps (coarse mesh): GNRM converges, no penetration."""
-    from fenics_contact.model.problem import PathDisplacement
-
-    md = tbm.ironing(MPI.COMM_WORLD, h_indenter=0.08, h_block=0.12)
-    ft = md.facet_tags
-    bodies = [Body("indenter", tbm.STRIKER_TAG, material("neo-hookean", 1000.0, 0.3)),
-              Body("block", tbm.TARGET_TAG, material("neo-hookean", 100.0, 0.3))]
-    path = ((0.0, 0.0, 0.0), (0.2, 0.0, -0.1), (1.0, 0.6, -0.1))
-    problem = two_body_problem(
-        md.mesh, md.cell_tags, bodies, ft.find(tbm.STRIKER_FACE_TAG),
-        ft.find(tbm.TARGET_FACE_TAG), ContactSettings(r=1.0),
-        prescribed=[PrescribedDisplacement(ft.find(tbm.SUPPORT_TAG), (0.0, 0.0)),
-                    PathDisplacement(ft.find(tbm.LOAD_TAG), (None, None), path=path)],
-    )
+    problem, body = _with_mesh(cases.ironing(h_indenter=0.08, h_block=0.12, slide=0.6))
     from fenics_contact.solvers.predictor import Extrapolated
     from fenics_contact.solvers.stepping import solve_load_path
 
@@ -228,7 +217,7 @@ def test_ironing_short() -> None:
         orders.append(_order(step.residuals[-1]))
         assert problem.contact_state().constraint_penetration <= 1e-8 * 0.5
         depths.append(step.max_penetration)
-        vertical.append(problem.reaction(ft.find(tbm.LOAD_TAG))[1])
+        vertical.append(problem.reaction(_facets(body, "top"))[1])
 
     path = solve_load_path(strategy, 10, max_cutbacks=3, on_step=check)
     assert path.converged and len(orders) == 10
@@ -290,10 +279,18 @@ def test_two_hemispheres_hertz_coarse() -> None:
 
     Slow only through the first FFCx compilation of the 3D forms (about a minute).
     """
-    from fenics_contact.verification.hertz3d import hertz_point_contact
+    import dataclasses
+    from pathlib import Path
 
-    md = tbm.two_hemispheres(MPI.COMM_WORLD, h_contact=0.05)
-    problem = linear_pair(md, ContactSettings(r=1.0), hemispheres_fixed(0.02))
+    from fenics_contact import build_problem, load_scene
+    from fenics_contact.references.hertz3d import hertz_point_contact
+
+    # the shipped quarter model: flat faces pushed 0.02 closer, symmetric on x = 0, y = 0
+    scene = load_scene(Path(__file__).resolve().parents[1] / "scenes" / "two_hemispheres_3d.toml")
+    scene = dataclasses.replace(scene, mesh=dataclasses.replace(
+        scene.mesh, parameters={**scene.mesh.parameters, "h_contact": 0.05}))
+    assert scene.dirichlet[0].value == (None, None, -0.02)
+    problem = build_problem(with_contact_settings(scene, 1.0, relative=True))
     its = _solve(problem, "gnrm", 2)
     assert all(i <= 6 for i in its)
     state = problem.contact_state()
@@ -312,7 +309,7 @@ def test_two_hemispheres_hertz_coarse() -> None:
 @pytest.mark.mpi
 def test_target_force_balances_contact_force() -> None:
     """The force handed to the target's vertices sums to the striker's contact force."""
-    problem, ft = _blocks(8, 11)
+    problem, body = _blocks(8, 11)
     _solve(problem, "gnrm", 1)
     f = problem.target_force()
     n = problem.V.dofmap.index_map.size_local
@@ -320,30 +317,33 @@ def test_target_force_balances_contact_force() -> None:
     state = problem.contact_state()
     # pressed down: the target is pushed in -y by the normal force (nearly flat interface)
     assert abs(total[1] + state.contact_force) <= 1e-5 * state.contact_force  # facet tilt
-    bottom = problem.reaction(ft.find(tbm.SUPPORT_TAG))[1]
+    bottom = problem.reaction(_facets(body, "bottom"))[1]
     assert abs(total[1] + bottom) <= 1e-10 * state.contact_force
 
 
 def test_two_body_problem_errors() -> None:
-    md = tbm.block_on_block(MPI.COMM_WORLD, n_upper=2, n_lower=2)
-    ft = md.facet_tags
+    md = build_mesh(cases.block_on_block(2, 2))
     law = material("linear", 200.0, 0.3)
-    bodies = [Body("upper", tbm.STRIKER_TAG, law), Body("lower", tbm.TARGET_TAG, law)]
-    s, t = ft.find(tbm.STRIKER_FACE_TAG), ft.find(tbm.TARGET_FACE_TAG)
+    bodies = [Body("upper", md.cell_names["striker"], law),
+              Body("lower", md.cell_names["target"], law)]
+    s, t = _facets(md, "striker_face"), _facets(md, "target_face")
     with pytest.raises(ValueError, match="share facets"):
-        two_body_problem(md.mesh, md.cell_tags, bodies, s, s, ContactSettings())
+        two_body_problem(md.domain, md.cell_tags, bodies, s, s, ContactSettings())
     with pytest.raises(ValueError, match="quadrature = 'nodal'"):
-        two_body_problem(md.mesh, md.cell_tags, bodies, s, t, ContactSettings(quadrature="gauss"))
+        two_body_problem(md.domain, md.cell_tags, bodies, s, t,
+                         ContactSettings(quadrature="gauss"))
     with pytest.raises(ValueError, match="cell tag 9"):
-        two_body_problem(md.mesh, md.cell_tags, [bodies[0], Body("x", 9, law)], s, t,
+        two_body_problem(md.domain, md.cell_tags, [bodies[0], Body("x", 9, law)], s, t,
                          ContactSettings())
     with pytest.raises(ValueError, match="not among the bodies"):
-        two_body_problem(md.mesh, md.cell_tags, bodies, s, t, ContactSettings(), striker="top")
+        two_body_problem(md.domain, md.cell_tags, bodies, s, t, ContactSettings(),
+                         striker="top")
 
 
 def test_stability_grid_two_body_case() -> None:
     """Two-body stability cases run through the same driver: auto at r = 1e8 E/h."""
-    from fenics_contact.studies.stability import full_grid, run_case, select
+    from benchmarks.robustness.stability_grid import full_grid
+    from fenics_contact.sweeps.stability import run_case, select
 
     groups = {c.group for c in full_grid()}
     assert {"two-body-r", "two-body-stiffness", "two-body-sliding"} <= groups

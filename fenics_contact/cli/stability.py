@@ -1,24 +1,32 @@
-"""``fenics-contact stability``: every method on a grid of extreme cases."""
+"""``fenics-contact stability``: every method on scenes at extreme r, each run with a status."""
 
 from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 
-from fenics_contact.cli.study import methods
+from fenics_contact.cli.study import floats, methods
+
+#: r values (relative to E/h) of ``fenics-contact stability`` by default: 1e-8 ... 1e12.
+EXTREME_R = tuple(10.0**e for e in range(-8, 13, 4))
 
 
-def _stability(args: argparse.Namespace) -> int:
+def run_grid_and_write(cases: Sequence, args: argparse.Namespace) -> int:
+    """Run ``cases`` with the options in ``args``; write CSV, JSON and the picture to args.out.
+
+    Returns the exit code: 0, or 1 when a run ended with an error (an
+    exception, not a solver status).
+    """
     from mpi4py import MPI
 
     from fenics_contact.output.io import write_csv, write_json
-    from fenics_contact.studies.stability import ERROR, full_grid, run_grid, select
-    from fenics_contact.studies.sweep_plots import stability_plot
+    from fenics_contact.sweeps.stability import ERROR, run_grid
+    from fenics_contact.sweeps.sweep_plots import stability_plot
 
     out: Path = args.out
     rank0 = MPI.COMM_WORLD.rank == 0
-    cases = select(full_grid(), args.cases)
     records = []
 
     def keep(rec) -> None:
@@ -61,27 +69,11 @@ def _names(text: str) -> list[str]:
     return [s.strip() for s in text.split(",") if s.strip()]
 
 
-def register(sub: argparse._SubParsersAction) -> None:
-    """Add the ``stability`` subcommand."""
+def add_run_options(cmd: argparse.ArgumentParser, default_out: Path) -> None:
+    """The options every stability run takes (methods, limits, tolerance, output folder)."""
     from fenics_contact.model.scaling import DEFAULT_FORCE_RTOL
-    from fenics_contact.studies.stability import METHODS
+    from fenics_contact.sweeps.stability import METHODS
 
-    cmd = sub.add_parser(
-        "stability",
-        help="run every method on extreme cases and record each status",
-        description="Run methods on extreme cases (r 1e-8 ... 1e12 E/h, E 1e-3 ... 1e12, "
-        "nu up to 0.4999, 1/10/100 load steps, initial penetration, grazing, no and full "
-        "contact, coarse and fine meshes, two deformable bodies, Coulomb friction mu 0 ... 10, "
-        "r extremes and a load reversal with friction, on a rigid plane and between two "
-        "blocks); record each run's status, iterations, forces, F_t/(mu N) and whether it "
-        "reached the reference answer (GNRM at r = 1 E/h); write stability.csv, "
-        "stability.json, stability.png and per-run step records under cases/. Exit code 0, "
-        "or 1 when a run ended with an error (an exception, not a solver status).",
-    )
-    cmd.add_argument("--cases", type=_names, default=None,
-                     help="comma-separated case names or groups (r, E, nu, steps, start, mesh, "
-                     "two-body-r, two-body-stiffness, two-body-sliding, friction, friction-r, "
-                     "two-body-friction, two-body-friction-r); default: all")
     cmd.add_argument("--methods", type=methods, default=list(METHODS),
                      help="comma-separated strategies (default penalty,sua,nua,gnrm,auto)")
     cmd.add_argument("--max-iterations", type=int, default=100,
@@ -90,5 +82,49 @@ def register(sub: argparse._SubParsersAction) -> None:
                      help="step halvings allowed after a failed step (default 0)")
     cmd.add_argument("--force-rtol", type=float, default=DEFAULT_FORCE_RTOL,
                      help="tolerance relative to the force scale E h^(d-1) (default 1e-10)")
-    cmd.add_argument("--out", type=Path, default=Path("results/stability"), help="output folder")
+    cmd.add_argument("--out", type=Path, default=default_out, help="output folder")
+
+
+def run_cases(cases: Sequence, argv: Sequence[str], default_out: Path) -> int:
+    """Command line of a named grid of cases (``--cases`` picks names or groups)."""
+    from fenics_contact.sweeps.stability import select
+
+    parser = argparse.ArgumentParser(description="Run every method on a grid of extreme cases.")
+    groups = ",".join(dict.fromkeys(c.group for c in cases))
+    parser.add_argument("--cases", type=_names, default=None,
+                        help=f"comma-separated case names or groups ({groups}); default: all")
+    add_run_options(parser, default_out)
+    args = parser.parse_args(list(argv))
+    try:
+        chosen = select(cases, args.cases)
+    except ValueError as exc:
+        parser.error(str(exc))
+    return run_grid_and_write(chosen, args)
+
+
+def _stability(args: argparse.Namespace) -> int:
+    from fenics_contact.scene.schema import load_scene
+    from fenics_contact.sweeps.stability import scene_cases
+
+    scenes = [load_scene(path) for path in args.scenes]
+    return run_grid_and_write(scene_cases(scenes, args.r), args)
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the ``stability`` subcommand."""
+    cmd = sub.add_parser(
+        "stability",
+        help="run every method on scenes at extreme r and record each status",
+        description="Run methods on each scene at each r (default 1e-8 ... 1e12 E/h); record "
+        "each run's status, iterations, forces, F_t/(mu N) and whether it reached the "
+        "reference answer (GNRM at r = 1 E/h); write stability.csv, stability.json, "
+        "stability.png and per-run step records under cases/. The project's own grid of "
+        "extremes (E, nu, steps, starts, meshes, friction, pairs) is "
+        "benchmarks/robustness/stability_grid.py. Exit code 0, or 1 when a run ended with "
+        "an error (an exception, not a solver status).",
+    )
+    cmd.add_argument("scenes", nargs="+", type=Path, help="scene files (.toml)")
+    cmd.add_argument("--r", type=floats, default=list(EXTREME_R),
+                     help="comma-separated r values relative to E/h (default 1e-8,1e-4,...,1e12)")
+    add_run_options(cmd, Path("results/stability"))
     cmd.set_defaults(func=_stability)

@@ -1,9 +1,10 @@
-"""``fenics-contact study``: method x r sweeps on a built-in example."""
+"""``fenics-contact study``: method x r sweeps on a scene, in the paper's table layout."""
 
 from __future__ import annotations
 
 import argparse
 import math
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 
@@ -33,14 +34,19 @@ def methods(text: str) -> list[str]:
     return names
 
 
-def _study(args: argparse.Namespace) -> int:
+def study_and_write(subjects: Sequence, args: argparse.Namespace) -> int:
+    """Run methods x r on the first subject (and on the others beside it); write the outputs.
+
+    ``subjects``: :class:`~fenics_contact.sweeps.study.Subject` values, the
+    first the one studied. Writes study.json, study.csv, table.md and the
+    residual and iteration pictures into ``args.out``.
+    """
     from fenics_contact.output.io import write_csv, write_json
     from fenics_contact.output.plotting import iterations_against_r, residual_histories
     from fenics_contact.solvers.diagnostics import SolverSettings
-    from fenics_contact.studies.study import comparison_table, paper_table, probe_line, run_study
-    from fenics_contact.verification.examples import EXAMPLES
+    from fenics_contact.sweeps.study import comparison_table, paper_table, probe_line, run_study
 
-    example = EXAMPLES[args.example]()
+    first = subjects[0]
     out: Path = args.out
     settings = SolverSettings(atol=args.tol, max_iterations=args.max_iterations)
 
@@ -51,31 +57,31 @@ def _study(args: argparse.Namespace) -> int:
             flush=True,
         )
 
-    print(f"Study {args.example}: methods {','.join(args.methods)}; r = {args.r}", flush=True)
-    records = run_study(
-        example, args.methods, args.r, relative=args.relative, settings=settings,
-        quadrature=args.quadrature, progress=show,
-    )
+    def study(subject) -> list:
+        return run_study(
+            subject.case, args.methods, args.r, relative=args.relative, settings=settings,
+            quadrature=args.quadrature, progress=show, probe=subject.probe,
+            exact=subject.exact,
+        )
+
+    print(f"Study {first.label}: methods {','.join(args.methods)}; r = {args.r}", flush=True)
+    records = study(first)
     table = paper_table(records, limit=args.max_iterations)
     print()
     print(table)
-    sources: list = [(args.example, records)]
-    published = getattr(example, "published_table", None)
-    if published is not None:
-        sources.append(("paper", published))
-    for other in args.beside:
-        print(f"\nStudy {other} (beside {args.example})", flush=True)
-        sources.append((other, run_study(
-            EXAMPLES[other](), args.methods, args.r, relative=args.relative,
-            settings=settings, quadrature=args.quadrature, progress=show,
-        )))
+    sources: list = [(first.label, records)]
+    if first.published is not None:
+        sources.append(("paper", first.published))
+    for other in subjects[1:]:
+        print(f"\nStudy {other.label} (beside {first.label})", flush=True)
+        sources.append((other.label, study(other)))
     if len(sources) > 1:
         table = comparison_table(sources, args.r, args.methods, limit=args.max_iterations)
-        print(f"\n{args.example} beside {', '.join(label for label, _ in sources[1:])}:\n")
+        print(f"\n{first.label} beside {', '.join(label for label, _ in sources[1:])}:\n")
         print(table)
         print()
     for label, source in sources:
-        if not isinstance(source, dict) and "penalty" in args.methods:
+        if not isinstance(source, Mapping) and "penalty" in args.methods:
             if any(math.isfinite(rec.probe) for rec in source):
                 print(f"Penalty probe ({label}): {probe_line(source)}")
     write_json(out / "study.json", [r.to_dict() for r in records])
@@ -87,43 +93,55 @@ def _study(args: argparse.Namespace) -> int:
     return 0
 
 
-def register(sub: argparse._SubParsersAction) -> None:
-    """Add the ``study`` subcommand."""
-    from fenics_contact.verification.examples import EXAMPLES
+def _study(args: argparse.Namespace) -> int:
+    from fenics_contact.scene.schema import load_scene
+    from fenics_contact.sweeps.study import Subject
 
-    study = sub.add_parser(
-        "study",
-        help="compare solution strategies over r on a built-in example",
-        description="Run methods x r on an example and write study.json, study.csv, "
-        "table.md and PNG plots (residual histories, iterations against r).",
-    )
-    study.add_argument("example", choices=sorted(EXAMPLES), help="which example to solve")
-    study.add_argument(
+    subjects = [Subject(path.stem, load_scene(path)) for path in [args.scene, *args.beside]]
+    return study_and_write(subjects, args)
+
+
+def add_study_options(cmd: argparse.ArgumentParser, default_out: Path) -> None:
+    """Methods, r values and stopping rules of a study (the paper's by default)."""
+    cmd.add_argument(
         "--methods", type=methods, default=["penalty", "sua", "nua", "gnrm"],
         help="comma-separated strategies: penalty,sua,nua,gnrm (default: all four)",
     )
-    study.add_argument(
+    cmd.add_argument(
         "--r", type=floats, default=[1.0, 10.0, 100.0, 1000.0, 10000.0],
         help="comma-separated r values, e.g. 1e6,1e8 (default 1,10,100,1000,10000)",
     )
-    study.add_argument(
+    cmd.add_argument(
         "--relative", action="store_true",
         help="read r relative to E/h (h: mean contact facet size) instead of absolute",
     )
-    study.add_argument(
-        "--quadrature", choices=["nodal", "gauss"], default="nodal",
-        help="contact integration: nodal (vertex rule, node-on-facet) or gauss",
+    cmd.add_argument(
+        "--quadrature", choices=["nodal", "gauss"], default=None,
+        help="contact integration: nodal (vertex rule, node-on-facet) or gauss "
+        "(default: each contact's own)",
     )
-    study.add_argument(
-        "--beside", type=str, action="append", default=[], choices=sorted(EXAMPLES),
-        metavar="EXAMPLE",
-        help="also run EXAMPLE with the same settings and print its rows beside "
-        "(repeatable; e.g. --beside paper-ex1-wedge)",
-    )
-    study.add_argument("--tol", type=float, default=1e-8, help="residual tolerance (1e-8)")
-    study.add_argument(
+    cmd.add_argument("--tol", type=float, default=1e-8, help="residual tolerance (1e-8)")
+    cmd.add_argument(
         "--max-iterations", type=int, default=500,
         help="Newton iteration limit per load step (500, as in the paper)",
     )
-    study.add_argument("--out", type=Path, default=Path("results/study"), help="output folder")
+    cmd.add_argument("--out", type=Path, default=default_out, help="output folder")
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the ``study`` subcommand."""
+    study = sub.add_parser(
+        "study",
+        help="compare solution strategies over r on a scene",
+        description="Run methods x r on a scene (from zero, no cut-back, one tolerance for "
+        "all, as in the paper) and write study.json, study.csv, table.md and PNG plots "
+        "(residual histories, iterations against r). The paper's Tables 1 and 2 beside "
+        "the published ones: benchmarks/research/paper_tables.py (make paper-tables).",
+    )
+    study.add_argument("scene", type=Path, help="the scene file (.toml)")
+    study.add_argument(
+        "--beside", type=Path, action="append", default=[], metavar="SCENE",
+        help="also run SCENE with the same settings and print its rows beside (repeatable)",
+    )
+    add_study_options(study, Path("results/study"))
     study.set_defaults(func=_study)

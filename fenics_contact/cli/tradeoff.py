@@ -1,20 +1,22 @@
-"""``fenics-contact tradeoff``: speed against accuracy over methods x r x meshes."""
+"""``fenics-contact tradeoff``: speed against accuracy over methods x r on scenes (meshes)."""
 
 from __future__ import annotations
 
 import argparse
 import math
+from collections.abc import Sequence
 from pathlib import Path
 
 from fenics_contact.cli.study import floats, methods
 
 
-def _tradeoff(args: argparse.Namespace) -> int:
+def tradeoff_and_write(cases: Sequence, args: argparse.Namespace) -> int:
+    """Run the trade-off on ``cases`` (:class:`TradeoffCase`); write JSON, CSV, table, picture."""
     from mpi4py import MPI
 
     from fenics_contact.output.io import write_csv, write_json
-    from fenics_contact.studies.sweep_plots import tradeoff_plot
-    from fenics_contact.studies.tradeoff import markdown_table, run_tradeoff
+    from fenics_contact.sweeps.sweep_plots import tradeoff_plot
+    from fenics_contact.sweeps.tradeoff import markdown_table, run_tradeoff
 
     out: Path = args.out
     rank0 = MPI.COMM_WORLD.rank == 0
@@ -35,8 +37,8 @@ def _tradeoff(args: argparse.Namespace) -> int:
             )
 
     records = run_tradeoff(
-        args.scene, args.methods, args.r, meshes=args.meshes, mu=args.mu, progress=show,
-        repeats=args.repeats, max_iterations=args.max_iterations,
+        cases, args.methods, args.r, progress=show, repeats=args.repeats,
+        max_iterations=args.max_iterations,
     )
     table = markdown_table(records)
     if rank0:
@@ -51,65 +53,46 @@ def _tradeoff(args: argparse.Namespace) -> int:
     return 0
 
 
-def _scenes(text: str) -> list[str]:
-    """Scene names, with the groups 'frictionless', 'friction' and 'all' expanded."""
-    from fenics_contact.studies.tradeoff import FRICTION_SCENES, FRICTIONLESS_SCENES
+def add_tradeoff_options(cmd: argparse.ArgumentParser, default_out: Path) -> None:
+    """Methods, r values, repeats, iteration cap and output folder of a trade-off."""
+    from fenics_contact.sweeps.tradeoff import FULL_R, METHODS
 
-    groups = {"frictionless": FRICTIONLESS_SCENES, "friction": FRICTION_SCENES,
-              "all": FRICTIONLESS_SCENES + FRICTION_SCENES}
-    known = FRICTIONLESS_SCENES + FRICTION_SCENES
-    names: list[str] = []
-    for name in (s.strip().lower() for s in text.split(",") if s.strip()):
-        names += groups.get(name, (name,))
-    bad = [s for s in names if s not in known]
-    if bad or not names:
-        raise argparse.ArgumentTypeError(
-            f"unknown scene(s) {bad or text!r}; use {','.join(known)} or a group: "
-            f"{','.join(groups)}"
-        )
-    return list(dict.fromkeys(names))
-
-
-def _coefficients(text: str) -> list[float]:
-    """Comma-separated Coulomb coefficients, each finite and > 0."""
-    try:
-        values = [float(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        values = []
-    if not values or not all(0 < v < float("inf") for v in values):
-        raise argparse.ArgumentTypeError(
-            f"--mu takes comma-separated friction coefficients > 0 such as 0.1,0.3,1, got {text!r}"
-        )
-    return values
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    """Add the ``tradeoff`` subcommand."""
-    from fenics_contact.studies.tradeoff import FRICTION_MU, FULL_R, METHODS
-
-    cmd = sub.add_parser(
-        "tradeoff",
-        help="measure wall time against accuracy over methods x r x meshes",
-        description="Sweep methods x r (relative to E/h) x meshes on the Hertz cylinder and "
-        "the Example 2 bar, and with Coulomb friction on the sliding block (scene 'slide', "
-        "one case per mu); write tradeoff.json, tradeoff.csv, table.md and tradeoff.png "
-        "(error against time, Pareto front marked).",
-    )
-    cmd.add_argument("--scene", type=_scenes, default=["hertz", "bar"],
-                     help="comma-separated scenes hertz,bar,slide or groups frictionless "
-                     "(hertz,bar), friction (slide), all (default frictionless)")
-    cmd.add_argument("--mu", type=_coefficients, default=list(FRICTION_MU),
-                     help="Coulomb coefficients of the friction cases (default "
-                     f"{','.join(f'{m:g}' for m in FRICTION_MU)})")
     cmd.add_argument("--methods", type=methods, default=list(METHODS),
                      help="comma-separated strategies (default penalty,sua,nua,gnrm,auto)")
     cmd.add_argument("--r", type=floats, default=list(FULL_R),
                      help="comma-separated r relative to E/h (default 1e-4 ... 1e8)")
-    cmd.add_argument("--meshes", type=int, choices=[1, 2, 3], default=3,
-                     help="how many meshes, coarse first (default 3)")
     cmd.add_argument("--repeats", type=int, default=3,
                      help="timed repeats of a converged run; the median is kept (default 3)")
     cmd.add_argument("--max-iterations", type=int, default=200,
                      help="Newton iteration cap per load step (default 200)")
-    cmd.add_argument("--out", type=Path, default=Path("results/tradeoff"), help="output folder")
+    cmd.add_argument("--out", type=Path, default=default_out, help="output folder")
+
+
+def _tradeoff(args: argparse.Namespace) -> int:
+    from fenics_contact.scene.schema import load_scene
+    from fenics_contact.sweeps.tradeoff import TradeoffCase
+
+    cases = []
+    for path in args.scenes:
+        scene = load_scene(path)
+        cases.append(TradeoffCase(args.name or scene.name, path.stem, scene))
+    return tradeoff_and_write(cases, args)
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the ``tradeoff`` subcommand."""
+    cmd = sub.add_parser(
+        "tradeoff",
+        help="measure wall time against accuracy over methods x r on scenes",
+        description="Sweep methods x r (relative to E/h) on each scene (give the same "
+        "problem on several meshes as several scene files, coarse first); write "
+        "tradeoff.json, tradeoff.csv, table.md and tradeoff.png (error against time, "
+        "Pareto front marked). The project's own trade-off (Hertz, the Example 2 bar, the "
+        "sliding block with friction, three meshes each) is benchmarks/research/tradeoff.py.",
+    )
+    cmd.add_argument("scenes", nargs="+", type=Path, help="scene files (.toml)")
+    cmd.add_argument("--name", default=None,
+                     help="one name for all scenes (the meshes of one problem); default: "
+                     "each scene's own")
+    add_tradeoff_options(cmd, Path("results/tradeoff"))
     cmd.set_defaults(func=_tradeoff)

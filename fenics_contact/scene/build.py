@@ -46,6 +46,7 @@ from fenics_contact.scene.meshing import mesh_on_rank, open_geo
 from fenics_contact.scene.schema import (
     GENERATOR_TAGS,
     BoundarySpec,
+    ContactSpec,
     ObstacleContactSpec,
     ObstacleSpec,
     Scene,
@@ -212,7 +213,10 @@ def tagged_facets(body: BodyMesh, scene: Scene, section: str, tag: int | str) ->
     return body.facet_tags.find(number)
 
 
-def _restricted(body: BodyMesh, facets: np.ndarray, spec: BoundarySpec) -> np.ndarray:
+def _restricted(
+    body: BodyMesh, facets: np.ndarray, spec: BoundarySpec | ContactSpec
+) -> np.ndarray:
+    """The facets whose midpoints lie within the spec's coordinate bounds."""
     if not spec.bounds:
         return facets
     fdim = body.domain.topology.dim - 1
@@ -242,7 +246,8 @@ def contact_facets(
     """Candidate facets of one obstacle: by tag, or detected along the obstacle's path."""
     spec = entry.contact
     if spec.tag is not None:
-        return tagged_facets(body, scene, _contact_section(entry), spec.tag)
+        facets = tagged_facets(body, scene, _contact_section(entry), spec.tag)
+        return _restricted(body, facets, spec)
     from fenics_contact.model.candidates import detect_candidate_facets
 
     pushes = [abs(v) for d in scene.dirichlet for v in d.value if v is not None]

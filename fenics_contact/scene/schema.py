@@ -21,7 +21,8 @@ Layout (units are the user's; be consistent)::
                  schedule = [[t, dx, dy(, dz)], ...] (piecewise-linear
                  displacement against the load factor t, rows from t = 0 to
                  t = 1: a load path in phases, e.g. press then slide)
-    [contact]    tag, or detect = true with margin; r, relative, quadrature,
+    [contact]    tag (optionally x/y/z = [min, max] bounds on facet midpoints),
+                 or detect = true with margin; r, relative, quadrature,
                  mu (Coulomb friction coefficient, >= 0; absent: frictionless),
                  tangential_r_max (cap of the tangential parameter r_t =
                  min(r, tangential_r_max E/L), L the extent of the contact
@@ -170,7 +171,8 @@ def _check_mesh_file(reader: _Reader, file: Path) -> None:
         )
 
 
-def _boundary(reader: _Reader, dimension: int, allow_free: bool) -> BoundarySpec:
+def _bounds(reader: _Reader, dimension: int) -> dict[int, tuple[float, float]]:
+    """Optional x/y/z = [min, max] bounds on facet midpoints, by axis."""
     bounds = {}
     for axis, key in enumerate("xyz"[:dimension]):
         if key in reader.table:
@@ -178,6 +180,11 @@ def _boundary(reader: _Reader, dimension: int, allow_free: bool) -> BoundarySpec
             if lo_hi[0] > lo_hi[1]:
                 raise reader.fail(key, "must be [min, max] with min <= max.")
             bounds[axis] = (lo_hi[0], lo_hi[1])
+    return bounds
+
+
+def _boundary(reader: _Reader, dimension: int, allow_free: bool) -> BoundarySpec:
+    bounds = _bounds(reader, dimension)
     path: tuple[tuple[float, ...], ...] = ()
     if "path" in reader.table:
         path = _path(reader, dimension)
@@ -301,7 +308,7 @@ def _obstacle(reader: _Reader, dimension: int) -> ObstacleSpec:
     )
 
 
-def _contact(reader: _Reader) -> ContactSpec:
+def _contact(reader: _Reader, dimension: int) -> ContactSpec:
     detect = reader.flag("detect", False)
     if detect == ("tag" in reader.table):
         raise SceneError(
@@ -310,6 +317,7 @@ def _contact(reader: _Reader) -> ContactSpec:
         )
     return ContactSpec(
         tag=reader.tag("tag") if not detect else None,
+        bounds=_bounds(reader, dimension) if not detect else {},
         detect=detect,
         margin=reader.number("margin", 0.0) if detect else 0.0,
         r=_contact_r(reader),
@@ -442,7 +450,7 @@ def _obstacles(path: Path, data: dict[str, Any], dimension: int) -> tuple[Obstac
     if not isinstance(data.get("obstacle"), list):
         obstacle = _obstacle(_table(path, data, "obstacle"), dimension)
         return (_checked_entry(path, ObstacleContactSpec(
-            "obstacle", obstacle, _contact(_table(path, data, "contact")))),)
+            "obstacle", obstacle, _contact(_table(path, data, "contact"), dimension))),)
     return _obstacle_blocks(path, data, dimension)
 
 
@@ -468,7 +476,7 @@ def _obstacle_blocks(path: Path, data: dict[str, Any], dimension: int
             raise SceneError(f"{path.name}: [[obstacle]] {i + 1} name = {name!r}: give a word.")
         reader = _Reader(path, f"obstacle '{name}'", table)
         out.append(_checked_entry(path, ObstacleContactSpec(
-            name, _obstacle(reader, dimension), _contact(reader))))
+            name, _obstacle(reader, dimension), _contact(reader, dimension))))
     names = [o.name for o in out]
     if len(set(names)) != len(names):
         raise SceneError(f"{path.name}: [[obstacle]] names {names} repeat; name each once.")

@@ -100,12 +100,14 @@ class ContactSpec(ContactSettings):
     """Where contact may happen, and how it is regularised (r, relative, quadrature).
 
     The settings the contact term takes (:class:`ContactSettings`) plus the
-    candidate facets (a tag, or detection along the obstacle's path within
-    ``margin``) and Coulomb friction (``mu``, None frictionless; the cap of
-    r_t, ``tangential_r_max`` E/L).
+    candidate facets (a tag, optionally within coordinate ``bounds``, or
+    detection along the obstacle's path within ``margin``) and Coulomb
+    friction (``mu``, None frictionless; the cap of r_t, ``tangential_r_max`` E/L).
     """
 
     tag: int | str | None = None
+    #: Optional [min, max] bounds on the tagged facets' midpoints, by axis (0 x, 1 y, 2 z).
+    bounds: dict[int, tuple[float, float]] = field(default_factory=dict)
     detect: bool = False
     margin: float = 0.0
     mu: float | None = None

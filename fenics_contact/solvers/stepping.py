@@ -90,7 +90,7 @@ class RunRecord:
 
     The CLI's summary.json, the studies' tables and CSV files and the
     benchmarks all read this record; a study that needs more columns
-    subclasses it (see :mod:`fenics_contact.studies`).
+    subclasses it (see :mod:`fenics_contact.sweeps`).
 
     Attributes:
         status: converged, the failing status of the last step, or ``error``

@@ -1,0 +1,160 @@
+"""The cost of contact: the 2D Hertz case with contact (GNRM) against the same body with
+the contact replaced by the equivalent Dirichlet condition on the final contact set.
+
+Both run side by side in one process on the same mesh, 10 load steps, the
+same Newton kernel, MUMPS and stopping test. The equivalent problem
+prescribes, on the nodes in contact at the end, the vertical displacement
+that puts them on the plane (u_y = -t y at load factor t), and the top
+face as in the contact case. Reported: time per load step of each, their
+ratio (target <= 1.3), and the split into assembly, linear solver and the
+rest, median of the repeats.
+
+Run: ``python benchmarks/performance/cost_of_contact.py [--repeats 5]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+
+import fenics_contact  # noqa: F401  (loads the DOLFINx wheel's MPI libraries: first)
+
+# isort: split
+import numpy as np
+import ufl
+from dolfinx import fem
+
+from benchmarks import cases, harness
+from benchmarks.validation.hertz2d import CYLINDER, STEPS
+from fenics_contact.model.problem import ContactProblem, VariationalSystem
+from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.base import newton_loop
+from fenics_contact.solvers.diagnostics import ConvergenceMonitor, SolverSettings
+from fenics_contact.solvers.newton import NewtonKernel
+from fenics_contact.solvers.predictor import Extrapolated
+from fenics_contact.solvers.stepping import solve_load_path
+
+SETTINGS = SolverSettings(atol=1e-8)
+
+
+def contact_run(predictor: str) -> tuple[dict, ContactProblem]:
+    """Solve with contact; return the record and the solved problem."""
+    problem = cases.build(CYLINDER, 1.0, relative=True, quadrature="nodal")
+    strategy = make_strategy("gnrm", problem, SETTINGS)
+    if predictor == "extrapolate":
+        strategy = Extrapolated(strategy)
+    kernel = strategy.kernel
+    before = kernel.timings.snapshot()
+    start = time.perf_counter()
+    path = solve_load_path(strategy, STEPS)
+    total = time.perf_counter() - start
+    assert path.converged, path.status
+    t = kernel.timings.since(before).to_dict()
+    return {
+        "case": f"contact GNRM ({predictor})",
+        "newton": path.iterations,
+        "jacobians": t["jacobians"],
+        "residuals": t["residuals"],
+        "per_step_s": total / STEPS,
+        **harness.split(total, t),
+    }, problem
+
+
+class DirichletEquivalent:
+    """The contact body with the final contact set held on the plane by Dirichlet conditions."""
+
+    def __init__(self, solved: ContactProblem) -> None:
+        self.problem = solved
+        V = solved.V
+        active = solved.contact_state().active
+        points = solved.nodal_coordinates()[active]
+        Vy, _ = V.sub(1).collapse()
+
+        def on_contact_set(x: np.ndarray) -> np.ndarray:
+            d = np.min(np.linalg.norm(x.T[:, None, :2] - points[None, :, :2], axis=2), axis=1)
+            return d < 1e-10
+
+        dofs = fem.locate_dofs_geometrical((V.sub(1), Vy), on_contact_set)
+        self.g = fem.Function(Vy)
+        self.g_final = -Vy.tabulate_dof_coordinates()[:, 1]
+        bc = fem.dirichletbc(self.g, dofs, V.sub(1))
+        self.u = fem.Function(V)
+        v = ufl.TestFunction(V)
+        energy = solved.material.strain_energy(self.u) * ufl.dx
+        system = VariationalSystem("dirichlet", [ufl.derivative(energy, self.u, v)], [self.u],
+                                   [*solved.bcs, bc])
+        self.kernel = NewtonKernel(system)
+        self.n_contact = int(np.sum(active))
+
+    def run(self) -> dict:
+        """Ten load steps with the same Newton loop and stopping test."""
+        self.u.x.array[:] = 0.0
+        kernel = self.kernel
+        before = kernel.timings.snapshot()
+        newton = 0
+        start = time.perf_counter()
+        for k in range(1, STEPS + 1):
+            t = k / STEPS
+            self.problem.set_load(t)
+            self.g.x.array[:] = t * self.g_final
+            status, steps = newton_loop(
+                kernel, ConvergenceMonitor(SETTINGS), kernel.assemble_residual, lambda: None
+            )
+            assert status == "converged", status
+            newton += steps
+        total = time.perf_counter() - start
+        t = kernel.timings.since(before).to_dict()
+        return {
+            "case": "Dirichlet on final contact set",
+            "newton": newton,
+            "jacobians": t["jacobians"],
+            "residuals": t["residuals"],
+            "per_step_s": total / STEPS,
+            **harness.split(total, t),
+        }
+
+
+def main() -> None:
+    """Contact (with and without the predictor) and Dirichlet, interleaved repeats."""
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--out", type=Path, default=harness.OUT)
+    args = parser.parse_args()
+    _, solved = contact_run("extrapolate")  # warm-up, and the final contact set
+    equivalent = DirichletEquivalent(solved)
+    equivalent.run()
+    runs: dict[str, list[dict]] = {"extrapolate": [], "previous": [], "dirichlet": []}
+    for _ in range(args.repeats):  # interleaved: the same machine load for all three
+        runs["extrapolate"].append(contact_run("extrapolate")[0])
+        runs["previous"].append(contact_run("previous")[0])
+        runs["dirichlet"].append(equivalent.run())
+    med = {k: harness.median_dict(v) for k, v in runs.items()}
+    ratios = {
+        k: float(np.median([c["per_step_s"] / d["per_step_s"]
+                            for c, d in zip(runs[k], runs["dirichlet"], strict=True)]))
+        for k in ("extrapolate", "previous")
+    }
+    rows = [
+        (m["case"], m["newton"], m["jacobians"], m["residuals"], m["per_step_s"] * 1e3,
+         m["assembly_s"] / STEPS * 1e3, m["linear_s"] / STEPS * 1e3, m["rest_s"] / STEPS * 1e3,
+         ratios.get(k, 1.0))
+        for k, m in med.items()
+    ]
+    header = ("case", "Newton", "Jacobians", "residuals", "ms / step", "assembly ms / step",
+              "linear ms / step", "rest ms / step", "ratio to Dirichlet")
+    table = harness.md_table(header, rows)
+    harness.write(
+        "cost_of_contact",
+        {"machine": harness.machine(), "repeats": args.repeats, "median": med, "ratio": ratios,
+         "contact_nodes": equivalent.n_contact, "runs": runs},
+        table, args.out,
+    )
+    print(table)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,1 +1,0 @@
-"""Problems with known answers: analytic references and benchmark problems, each defined once."""
