@@ -76,7 +76,6 @@ from fenics_contact.scene.sections import (
     elastic_constants,
     read_bodies,
     read_boundary,
-    read_fields,
     read_mesh,
     read_solver,
     why_bounded,
@@ -148,7 +147,7 @@ def scene_from_data(data: dict[str, Any], path: Path | str) -> Scene:
     mesh_spec, dirichlet, tractions = _conditions(path, data, dimension)
     obstacles = read_obstacles(path, data, dimension)
     mu = next((o.contact.mu for o in obstacles if o.contact.mu is not None), None)
-    fields = read_fields(output, mu, "[contact]")
+    fields = _fields(output, mu, "[contact]")
     return Scene(
         **_header(path, head, dimension),
         mesh=mesh_spec,
@@ -227,7 +226,7 @@ def _two_body_scene(path: Path, data: dict[str, Any], head: _Reader, dimension: 
     output = _table(path, data, "output", required=False)
     mu = next((m for m in [p.mu for p in pairs] + [o.contact.mu for o in obstacles]
                if m is not None), None)
-    fields = read_fields(output, mu, "[[pair]] or [[obstacle]]")
+    fields = _fields(output, mu, "[[pair]] or [[obstacle]]")
     mesh_spec, dirichlet, tractions = _conditions(path, data, dimension)
     return Scene(
         **_header(path, head, dimension),
@@ -245,6 +244,17 @@ def _two_body_scene(path: Path, data: dict[str, Any], head: _Reader, dimension: 
         pairs=pairs,
         obstacles=obstacles,
     )
+
+
+def _fields(output: _Reader, mu: float | None, section: str) -> tuple[str, ...]:
+    """The output fields: all by default; friction fields only with a coefficient mu."""
+    allowed = FIELDS + FRICTION_FIELDS if mu is not None else FIELDS
+    fields = output.table.get("fields")
+    fields = list(allowed) if fields is None else fields
+    if not isinstance(fields, list) or any(f not in allowed for f in fields):
+        hint = "" if mu is not None else f" (friction fields need {section} mu)"
+        raise output.fail("fields", f"choose from {', '.join(allowed)}{hint}.")
+    return tuple(fields)
 
 
 __all__ = [

@@ -1,4 +1,4 @@
-"""Scene sections read from their tables: mesh, conditions, bodies, solver, output.
+"""Scene sections read from their tables: mesh, conditions, bodies, solver.
 
 Each function checks one section's keys and returns its spec
 (:mod:`.spec`), raising :class:`~.spec.SceneError` that names the key, the
@@ -13,8 +13,6 @@ from typing import Any
 from fenics_contact.model.materials import MATERIALS, elastic_constants_problem
 from fenics_contact.scene.reader import _array, _Reader
 from fenics_contact.scene.spec import (
-    FIELDS,
-    FRICTION_FIELDS,
     GENERATOR_TAGS,
     METHODS,
     BodySpec,
@@ -196,18 +194,8 @@ def read_solver(reader: _Reader) -> SolverSpec:
     )
 
 
-def read_fields(output: _Reader, mu: float | None, section: str) -> tuple[str, ...]:
-    """The output fields: all by default; friction fields only with a coefficient mu."""
-    allowed = FIELDS + FRICTION_FIELDS if mu is not None else FIELDS
-    fields = output.table.get("fields")
-    fields = list(allowed) if fields is None else fields
-    if not isinstance(fields, list) or any(f not in allowed for f in fields):
-        hint = "" if mu is not None else f" (friction fields need {section} mu)"
-        raise output.fail("fields", f"choose from {', '.join(allowed)}{hint}.")
-    return tuple(fields)
-
 
 __all__ = [
     "MAX_CUTBACKS", "MAX_ITERATIONS", "MAX_STEPS", "elastic_constants", "read_bodies",
-    "read_boundary", "read_fields", "read_mesh", "read_solver", "why_bounded",
+    "read_boundary", "read_mesh", "read_solver", "why_bounded",
 ]
