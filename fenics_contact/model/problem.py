@@ -21,7 +21,7 @@ the body conditions of :mod:`.body` and the constructors of :mod:`.compositions`
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import ufl
@@ -305,8 +305,12 @@ class ContactProblem(FrictionalContacts):
 
     # -- systems handed to solvers ------------------------------------------------------------
     def _system(self, name: str, energy: ufl.Form, *, with_lam: bool,
-                tangential=None) -> VariationalSystem:
-        """Residual blocks of ``energy`` (see :func:`~.residuals.energy_system`)."""
+                tangential: Callable | None = None) -> VariationalSystem:
+        """Residual blocks of ``energy``, named ``name`` (+ "_friction" with friction).
+
+        See :func:`~.residuals.energy_system`; ``tangential(friction)`` is the
+        tangential traction of each frictional contact's work (force per area).
+        """
         suffix = "_friction" if self.frictional else ""
         return energy_system(name + suffix, energy, self.u, self.bcs, self.contacts,
                              with_lam=with_lam, tangential=tangential)
