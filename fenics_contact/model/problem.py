@@ -4,25 +4,28 @@ The problem owns nothing but the composition: the displacement ``u`` and
 the conditions belong to the :class:`~.body.Solid`, each contact
 (:mod:`.obstacle_contact`, :mod:`.pairs`) owns its multiplier ``lam`` (P1
 on its contact submesh), its parameter ``r`` and its friction. The problem
-hands solvers :class:`VariationalSystem` objects (UFL residual blocks with
-their unknowns: u, every contact's lam, every frictional contact's lam_t,
-then the deformable targets' extras) and never imports a solver itself. All
-loads are proportional to one load factor ``t`` in [0, 1].
+hands solvers :class:`~.variational_system.VariationalSystem` objects (UFL
+residual blocks with their unknowns: u, every contact's lam, every frictional
+contact's lam_t, then the deformable targets' extras; built by
+:mod:`.residuals`) and never imports a solver itself. All loads are
+proportional to one load factor ``t`` in [0, 1].
 
 Solvers see one system and one set of answers (the state, the active
 pattern, the multiplier update, the checks) whatever the contacts are; the
 accessors that name one contact's objects (``lam``, ``surface``, ...) are
-those of the first contact.
+those of the first contact; the friction accessors are
+:class:`~.problem_friction.FrictionalContacts`. This module also re-exports
+the names callers take from it: the value types of :mod:`.variational_system`,
+the body conditions of :mod:`.body` and the constructors of :mod:`.compositions`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
 
 import numpy as np
 import ufl
-from dolfinx import fem, mesh
+from dolfinx import fem
 
 from fenics_contact.model.body import (
     Body,
@@ -33,62 +36,26 @@ from fenics_contact.model.body import (
     SurfaceTraction,
     energy_quadrature_degree,
 )
+from fenics_contact.model.compositions import one_body_problem, two_body_problem
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.contacts import Contact
-from fenics_contact.model.friction import FrictionSettings
 from fenics_contact.model.materials import Elastic
 from fenics_contact.model.obstacle_contact import ObstacleContact
 from fenics_contact.model.obstacles import RigidObstacle
+from fenics_contact.model.problem_friction import FrictionalContacts
+from fenics_contact.model.residuals import (
+    complementarity_forms,
+    contact_entity_maps,
+    energy_system,
+    lagrangian,
+    penalty_energy,
+)
 from fenics_contact.model.state import ContactState, ProblemState, combined_state
 from fenics_contact.model.tags import facet_roles
-
-#: A non-potential residual term: (coefficient, test function) -> form (or None).
-Work = Callable[[fem.Function, ufl.Argument], ufl.Form]
+from fenics_contact.model.variational_system import Transfers, VariationalSystem, Work
 
 
-@dataclass
-class VariationalSystem:
-    """Residual blocks F_i(unknowns; tests) = 0 and what a solver needs to compile them.
-
-    Systems with deformable targets add ``extras``: coefficients (the target
-    vertex displacements w_k) that are a selection of ``unknowns[0]``
-    (w_k = S_k u), with one more residual block each after the unknowns'
-    blocks; ``transfer`` refreshes them (search) and names the selected
-    blocks (``sources()``, ``version``). A solver condenses them away
-    (solvers/condensed.py).
-    """
-
-    name: str
-    residuals: list[ufl.Form]
-    unknowns: list[fem.Function]
-    bcs: list[fem.DirichletBC]
-    entity_maps: list = field(default_factory=list)
-    extras: list[fem.Function] = field(default_factory=list)
-    transfer: object | None = None
-
-
-class Transfers:
-    """The searches of several deformable contacts seen as one (refresh, version, sources)."""
-
-    def __init__(self, transfers: Sequence[object]) -> None:
-        self.transfers = list(transfers)
-
-    def refresh(self) -> bool:
-        """Refresh every search; True when some assignment changed."""
-        changed = [t.refresh() for t in self.transfers]
-        return any(changed)
-
-    @property
-    def version(self) -> int:
-        """Grows whenever some search changes an assignment."""
-        return sum(t.version for t in self.transfers)
-
-    def sources(self) -> list[np.ndarray]:
-        """Every contact's selections, in the order of the systems' extras."""
-        return [s for t in self.transfers for s in t.sources()]
-
-
-class ContactProblem:
+class ContactProblem(FrictionalContacts):
     """A solid and its contacts, proportional loading.
 
     Args:
@@ -195,36 +162,6 @@ class ContactProblem:
         """The first body's law."""
         return self.solid.stiffest
 
-    def _friction(self):
-        frictional = [c.friction for c in self.contacts if c.friction is not None]
-        if not frictional:
-            raise AttributeError("The problem has no frictional contact.")
-        return frictional
-
-    @property
-    def lam_t(self) -> fem.Function:
-        """The first frictional contact's tangential multiplier."""
-        return self._friction()[0].lam_t
-
-    @property
-    def mu(self) -> fem.Constant:
-        """The first frictional contact's friction coefficient (a Constant)."""
-        return self._friction()[0].mu
-
-    @property
-    def friction_coefficient(self) -> float:
-        """The first frictional contact's mu (dimensionless)."""
-        return float(self.mu.value)
-
-    @property
-    def contact_extent(self) -> float:
-        """Extent L of the first frictional contact's surface (length)."""
-        return self._friction()[0].contact_extent
-
-    @property
-    def symmetry_constraints(self) -> int:
-        """Tangential components held at 0 by symmetry planes, over every contact."""
-        return sum(f.symmetry_constraints for f in self._friction())
 
     # -- unknowns ----------------------------------------------------------------------
     def normal_multipliers(self) -> list[fem.Function]:
@@ -270,7 +207,7 @@ class ContactProblem:
     @property
     def entity_maps(self) -> list:
         """The entity maps of every contact submesh (for forms on them)."""
-        return [m for c in self.contacts for m in c.surface.entity_maps]
+        return contact_entity_maps(self.contacts)
 
     def r_ratios(self) -> list[float]:
         """Each contact's r over the first contact's r (1 for one contact)."""
@@ -369,58 +306,14 @@ class ContactProblem:
     # -- systems handed to solvers ------------------------------------------------------------
     def _system(self, name: str, energy: ufl.Form, *, with_lam: bool,
                 tangential: Callable | None = None) -> VariationalSystem:
-        """Residual blocks from an energy plus the friction work.
+        """Residual blocks of ``energy``, named ``name`` (+ "_friction" with friction).
 
-        The residual of u (and of each extra coefficient c) is
-        dE/dc[test] + sum over frictional contacts of tau . d(dg_t)/dc[test],
-        tau = ``tangential(friction)``; with ``with_lam`` every contact's
-        multiplier block r dE/dlam[mu] (force units) follows u, then every
-        frictional contact's tangential block, before the extras' blocks.
+        See :func:`~.residuals.energy_system`; ``tangential(friction)`` is the
+        tangential traction of each frictional contact's work (force per area).
         """
-        frictions = [c.friction for c in self.contacts if c.friction is not None]
-
-        def residual(c: fem.Function) -> ufl.Form:
-            test = ufl.TestFunction(c.function_space)
-            form = ufl.derivative(energy, c, test)
-            if tangential is not None:
-                for f in frictions:
-                    form += f.work(tangential(f), c, test)
-            return form
-
-        residuals = [residual(self.u)]
-        unknowns = [self.u]
-        if with_lam:
-            for c in self.contacts:
-                residuals.append(c.r * ufl.derivative(energy, c.lam, ufl.TestFunction(c.Q)))
-                unknowns.append(c.lam)
-            for f in frictions:
-                residuals.append(f.tangential_residual())
-                unknowns.append(f.lam_t)
-        extras = [w for c in self.contacts for w in c.extras()]
-        residuals += [residual(w) for w in extras]
-        transfers = [c.transfer for c in self.contacts if c.transfer is not None]
-        transfer = None
-        if extras:
-            transfer = transfers[0] if len(transfers) == 1 else Transfers(transfers)
-        return VariationalSystem(name, residuals, unknowns, self.bcs, self.entity_maps,
-                                 extras=extras, transfer=transfer)
-
-    def _lagrangian(self) -> ufl.Form:
-        """Pi + sum over the contacts of int AL density ds (paper eq. 9)."""
-        form = self.potential
-        for c in self.contacts:
-            form = form + c.lagrangian()
-        return form
-
-    def _penalty_energy(self) -> ufl.Form:
-        """Pi + sum over the contacts of int r/2 min(g, 0)^2 ds (paper eq. 7)."""
-        form = self.potential
-        for c in self.contacts:
-            form = form + c.penalty()
-        return form
-
-    def _suffix(self) -> str:
-        return "_friction" if self.frictional else ""
+        suffix = "_friction" if self.frictional else ""
+        return energy_system(name + suffix, energy, self.u, self.bcs, self.contacts,
+                             with_lam=with_lam, tangential=tangential)
 
     def augmented_system(self) -> VariationalSystem:
         """Alart-Curnier saddle point on (u, lam[, lam_t]): the GNRM system.
@@ -428,13 +321,13 @@ class ContactProblem:
         The multiplier blocks are r dL/dlam = (min(lam + r g, 0) - lam) mu
         and (P(lam_t + r_t dg_t) - lam_t) . mu_t, in force units.
         """
-        return self._system("augmented" + self._suffix(), self._lagrangian(), with_lam=True,
-                            tangential=lambda f: f.traction_t)
+        return self._system("augmented", lagrangian(self.potential, self.contacts),
+                            with_lam=True, tangential=lambda f: f.traction_t)
 
     def primal_system(self) -> VariationalSystem:
         """Equilibrium in u with the multipliers held fixed (the Uzawa inner problem)."""
-        return self._system("primal" + self._suffix(), self._lagrangian(), with_lam=False,
-                            tangential=lambda f: f.traction_t)
+        return self._system("primal", lagrangian(self.potential, self.contacts),
+                            with_lam=False, tangential=lambda f: f.traction_t)
 
     def penalty_system(self) -> VariationalSystem:
         """Penalty regularisation (paper eq. 7) in u only; friction by regularised stick.
@@ -442,20 +335,16 @@ class ContactProblem:
         The disc radius is mu r max(-g, 0); lam_t holds the traction committed
         at the last converged step (updated by :meth:`commit`).
         """
-        return self._system("penalty" + self._suffix(), self._penalty_energy(), with_lam=False,
-                            tangential=lambda f: f.penalty_traction)
+        return self._system("penalty", penalty_energy(self.potential, self.contacts),
+                            with_lam=False, tangential=lambda f: f.penalty_traction)
 
     def complementarity_residual(self) -> ufl.Form | list[ufl.Form]:
         """(min(lam + r g, 0) - lam) mu per contact, and the tangential ones (force units).
 
         One form for one frictionless contact, else a list.
         """
-        forms = [c.complementarity_residual() for c in self.contacts]
-        forms += [f.tangential_residual() for f in self._frictions()]
+        forms = complementarity_forms(self.contacts)
         return forms[0] if len(forms) == 1 else forms
-
-    def _frictions(self) -> list:
-        return [c.friction for c in self.contacts if c.friction is not None]
 
     # -- diagnostics ---------------------------------------------------------------------
     def contact_state(self) -> ContactState:
@@ -511,106 +400,6 @@ class ContactProblem:
     def target_force(self) -> fem.Function:
         """Force the first contact's striker puts on its target's vertices (pairs only)."""
         return self.contact.target_force()
-
-    # -- friction over every frictional contact ----------------------------------------------
-    @property
-    def tangential_r(self) -> float:
-        """The first frictional contact's r_t (stress per length)."""
-        return self._friction()[0].tangential_r
-
-    @property
-    def tangential_cap(self) -> float:
-        """The first frictional contact's cap of r_t (stress per length)."""
-        return self._friction()[0].tangential_cap
-
-    def set_tangential_cap(self, cap: float) -> None:
-        """Set the cap of r_t of every frictional contact (absolute, stress per length)."""
-        for f in self._friction():
-            f.set_tangential_cap(cap)
-
-    def lower_tangential_r(self, factor: float = 0.5) -> float:
-        """Cap r_t at ``factor`` times its current value on every frictional contact.
-
-        The converged nodal answer does not depend on r_t; a smaller r_t keeps
-        the stick/slip guess from flipping (see :mod:`.friction`). Returns the
-        first frictional contact's new r_t (stress per length).
-        """
-        for f in self._friction():
-            f.set_tangential_cap(factor * f.tangential_r)
-        return self.tangential_r
-
-    def tangential_fields(self) -> tuple[np.ndarray, np.ndarray]:
-        """Owned nodal tangential traction on the body and slip, global axes (joined)."""
-        pairs = [f.tangential_fields() for f in self._friction()]
-        return (np.concatenate([p[0] for p in pairs]), np.concatenate([p[1] for p in pairs]))
-
-    def tangential_force_vector(self) -> np.ndarray:
-        """Sum over the frictional contacts of int T tau dA (force): minus the friction."""
-        return sum(f.tangential_force_vector() for f in self._friction())
-
-    def node_states(self) -> np.ndarray:
-        """Per owned node of the frictional contacts: 0 open, 1 stick, 2 slip."""
-        return np.concatenate([f.node_states() for f in self._friction()])
-
-    def coulomb_violations(self) -> tuple[float, float, float]:
-        """Worst nodal violations of the Coulomb conditions over every frictional contact."""
-        worst = [f.coulomb_violations() for f in self._friction()]
-        return tuple(max(w[i] for w in worst) for i in range(3))
-
-    def complementarity_norms(self) -> tuple[float, float]:
-        """Euclidean norms of the normal and tangential complementarity residuals (force)."""
-        squares = [f.complementarity_squares() for f in self._friction()]
-        return (float(np.sqrt(sum(s[0] for s in squares))),
-                float(np.sqrt(sum(s[1] for s in squares))))
-
-
-# -- the two common compositions ---------------------------------------------------------------
-def one_body_problem(
-    domain: mesh.Mesh,
-    material: Elastic,
-    obstacle: RigidObstacle,
-    contact_facets: np.ndarray,
-    settings: ContactSettings,
-    *,
-    prescribed: Sequence[PrescribedDisplacement] = (),
-    tractions: Sequence[SurfaceTraction] = (),
-    obstacle_motion: Sequence[float] | None = None,
-    obstacle_schedule: Sequence[Sequence[float]] | None = None,
-    degree: int = 1,
-    friction: FrictionSettings | None = None,
-) -> ContactProblem:
-    """One deformable body (every cell) against one rigid obstacle."""
-    solid = Solid(domain, [Body("body", None, material)], prescribed=prescribed,
-                  tractions=tractions, degree=degree)
-    contact = ObstacleContact(obstacle, contact_facets, settings, motion=obstacle_motion,
-                              schedule=obstacle_schedule, friction=friction)
-    return ContactProblem(solid, [contact])
-
-
-def two_body_problem(
-    domain: mesh.Mesh,
-    cell_tags: mesh.MeshTags,
-    bodies: Sequence[Body],
-    striker_facets: np.ndarray,
-    target_facets: np.ndarray,
-    settings: ContactSettings,
-    *,
-    striker: str | None = None,
-    target: str | None = None,
-    prescribed: Sequence[PrescribedDisplacement] = (),
-    tractions: Sequence[SurfaceTraction] = (),
-    degree: int = 1,
-    friction: FrictionSettings | None = None,
-    name: str = "pair",
-) -> ContactProblem:
-    """Bodies of one mesh with one node-to-segment pair (striker against target)."""
-    from fenics_contact.model.pairs import NodeToSegmentContact
-
-    solid = Solid(domain, bodies, cell_tags, prescribed=prescribed, tractions=tractions,
-                  degree=degree)
-    contact = NodeToSegmentContact(striker_facets, target_facets, settings, striker=striker,
-                                   target=target, friction=friction, name=name)
-    return ContactProblem(solid, [contact])
 
 
 __all__ = [

@@ -34,7 +34,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Any
 
 import numpy as np
 from dolfinx.fem import petsc as fem_petsc
@@ -99,18 +98,10 @@ class AutoStrategy(NewtonStrategy):
     """GNRM at a well-scaled internal r, with line search and penalty warm start."""
 
     name = "auto"
-
-    def __init__(
-        self,
-        problem: ContactProblem,
-        settings: SolverSettings,
-        *,
-        auto: AutoSettings | None = None,
-        **options: Any,
-    ) -> None:
-        super().__init__(problem, settings, **options)
-        self.auto = auto or AutoSettings()
-        self._penalty: NewtonKernel | None = None
+    tuning_type = AutoSettings
+    tuning: AutoSettings
+    #: The penalty kernel of the warm start, built the first time it is needed.
+    _penalty: NewtonKernel | None = None
 
     def build_system(self, problem: ContactProblem) -> VariationalSystem:
         """The Alart-Curnier system, as for GNRM."""
@@ -124,7 +115,7 @@ class AutoStrategy(NewtonStrategy):
     def working_r(self) -> float:
         """The user's r clamped to the window (absolute, stress per length)."""
         scale = self.problem.stiffness_scale
-        low, high = (w * scale for w in self.auto.r_window)
+        low, high = (w * scale for w in self.tuning.r_window)
         return min(max(self.problem.r_absolute, low), high)
 
     def rungs(self) -> list[float]:
@@ -133,7 +124,7 @@ class AutoStrategy(NewtonStrategy):
         r_work = self.working_r()
         if self.problem.nodal_rule or r_user <= r_work:
             return [r_work]
-        count = math.ceil(math.log(r_user / r_work) / math.log(self.auto.continuation_factor))
+        count = math.ceil(math.log(r_user / r_work) / math.log(self.tuning.continuation_factor))
         return [*np.geomspace(r_work, r_user, count + 1)[:-1].tolist(), r_user]
 
     # -- the solve -----------------------------------------------------------------
@@ -177,7 +168,7 @@ class AutoStrategy(NewtonStrategy):
         status = self._newton(settings, tally, line_search=True)
         status = retry_lowering_r_t(
             p, saved, status, lambda: self._newton(settings, tally, line_search=True),
-            self.auto.tangential_halvings, tally.switches, "line search",
+            self.tuning.tangential_halvings, tally.switches, "line search",
         )
         if status is Status.CONVERGED:
             return status
@@ -246,7 +237,7 @@ class AutoStrategy(NewtonStrategy):
         self, kernel: NewtonKernel, monitor: ConvergenceMonitor
     ) -> tuple[Status, int]:
         """Damped Newton: halve the step until the residual norm decreases enough."""
-        a = self.auto
+        a = self.tuning
         steps = 0
         norm = kernel.assemble_residual()
         while True:

@@ -151,11 +151,15 @@ class NewtonStrategy:
         settings: stopping rules.
         linear: linear solver of the Newton kernel (direct MUMPS when None).
         observer: called with (iterations, residual) at every residual check.
+        tuning: the strategy's own knobs, an instance of :attr:`tuning_type`
+            (its defaults when None; NUA's inner tolerance, auto's r window).
     """
 
     name = "newton"
     #: True when each step is followed by a multiplier update (counted as updates).
     updates_each_step = False
+    #: The class of the strategy's own knobs (a frozen dataclass), None when it has none.
+    tuning_type: type | None = None
 
     def __init__(
         self,
@@ -164,11 +168,15 @@ class NewtonStrategy:
         *,
         linear: LinearSolverSettings | None = None,
         observer: Observer | None = None,
+        tuning: object | None = None,
     ) -> None:
         self.problem = problem
         self.settings = settings
         self.linear = linear or LinearSolverSettings()
         self.observer = observer
+        if tuning is None and self.tuning_type is not None:
+            tuning = self.tuning_type()
+        self.tuning = tuning
         self.kernel = kernel_for(self.build_system(problem), linear=self.linear)
 
     def build_system(self, problem: ContactProblem) -> VariationalSystem:

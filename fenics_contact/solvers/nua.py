@@ -10,11 +10,9 @@ runs to the outer tolerance.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
-from fenics_contact.model.problem import ContactProblem
 from fenics_contact.solvers.base import SolveResult, timed
-from fenics_contact.solvers.diagnostics import SolverSettings, Status
+from fenics_contact.solvers.diagnostics import Status
 from fenics_contact.solvers.uzawa import UzawaBase
 
 
@@ -29,17 +27,8 @@ class NestedUzawa(UzawaBase):
     """Uzawa with an inner Newton solve between multiplier updates."""
 
     name = "nua"
-
-    def __init__(
-        self,
-        problem: ContactProblem,
-        settings: SolverSettings,
-        *,
-        nested: NestedSettings | None = None,
-        **options: Any,
-    ) -> None:
-        super().__init__(problem, settings, **options)
-        self.nested = nested or NestedSettings()
+    tuning_type = NestedSettings
+    tuning: NestedSettings
 
     def solve(self) -> SolveResult:
         """Outer updates until the coupled residual passes the stopping test."""
@@ -57,7 +46,7 @@ class NestedUzawa(UzawaBase):
             if status is not None:
                 break
             dual_done = self.complementarity_norm <= monitor.tolerance()
-            inner_tol = monitor.tolerance() if dual_done else self.nested.inner_atol
+            inner_tol = monitor.tolerance() if dual_done else self.tuning.inner_atol
             if self.primal_norm > inner_tol or not fresh:
                 if not self.kernel.newton_step():
                     status = monitor.fail()

@@ -84,6 +84,29 @@ class StepRecord:
         return asdict(self)
 
 
+class _StepTotal:
+    """A read-only :class:`RunRecord` total: one :class:`StepRecord` count over the steps.
+
+    The attribute's name is the count's name (``iterations = _StepTotal(...)``
+    sums ``step.iterations``).
+    """
+
+    def __init__(self, doc: str) -> None:
+        self.__doc__ = doc
+        self.name = ""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    def __get__(self, record: RunRecord | None, owner: type | None = None) -> int:
+        if record is None:
+            return self  # type: ignore[return-value]  # the class attribute: this descriptor
+        return sum(getattr(s, self.name) for s in record.steps)
+
+    def __set__(self, record: RunRecord, value: object) -> None:
+        raise AttributeError(f"{self.name} is the sum over the steps; change the steps.")
+
+
 @dataclass
 class RunRecord:
     """One run of a problem along its load path: the record every driver writes from.
@@ -126,25 +149,10 @@ class RunRecord:
         """R in stress per length (the paper's tables)."""
         return self.r_absolute
 
-    @property
-    def iterations(self) -> int:
-        """Newton iterations over the whole path."""
-        return sum(s.iterations for s in self.steps)
-
-    @property
-    def updates(self) -> int:
-        """Multiplier updates over the whole path."""
-        return sum(s.updates for s in self.steps)
-
-    @property
-    def linear_solves(self) -> int:
-        """Linear solves over the whole path."""
-        return sum(s.linear_solves for s in self.steps)
-
-    @property
-    def cutbacks(self) -> int:
-        """Increment halvings over the whole path."""
-        return sum(s.cutbacks for s in self.steps)
+    iterations = _StepTotal("Newton iterations over the whole path.")
+    updates = _StepTotal("Multiplier updates over the whole path.")
+    linear_solves = _StepTotal("Linear solves over the whole path.")
+    cutbacks = _StepTotal("Increment halvings over the whole path.")
 
     @property
     def steps_completed(self) -> int:

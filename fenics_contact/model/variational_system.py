@@ -1,0 +1,63 @@
+"""What a solver is handed: residual blocks, their unknowns and their conditions.
+
+A :class:`VariationalSystem` is plain data (UFL forms and DOLFINx objects);
+:mod:`.residuals` builds them from a problem's energies and
+:class:`~.problem.ContactProblem` names them (augmented, primal, penalty).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import ufl
+from dolfinx import fem
+
+#: A non-potential residual term: (coefficient, test function) -> form (or None).
+Work = Callable[[fem.Function, ufl.Argument], ufl.Form]
+
+
+@dataclass
+class VariationalSystem:
+    """Residual blocks F_i(unknowns; tests) = 0 and what a solver needs to compile them.
+
+    Systems with deformable targets add ``extras``: coefficients (the target
+    vertex displacements w_k) that are a selection of ``unknowns[0]``
+    (w_k = S_k u), with one more residual block each after the unknowns'
+    blocks; ``transfer`` refreshes them (search) and names the selected
+    blocks (``sources()``, ``version``). A solver condenses them away
+    (solvers/condensed.py).
+    """
+
+    name: str
+    residuals: list[ufl.Form]
+    unknowns: list[fem.Function]
+    bcs: list[fem.DirichletBC]
+    entity_maps: list = field(default_factory=list)
+    extras: list[fem.Function] = field(default_factory=list)
+    transfer: object | None = None
+
+
+class Transfers:
+    """The searches of several deformable contacts seen as one (refresh, version, sources)."""
+
+    def __init__(self, transfers: Sequence[object]) -> None:
+        self.transfers = list(transfers)
+
+    def refresh(self) -> bool:
+        """Refresh every search; True when some assignment changed."""
+        changed = [t.refresh() for t in self.transfers]
+        return any(changed)
+
+    @property
+    def version(self) -> int:
+        """Grows whenever some search changes an assignment."""
+        return sum(t.version for t in self.transfers)
+
+    def sources(self) -> list[np.ndarray]:
+        """Every contact's selections, in the order of the systems' extras."""
+        return [s for t in self.transfers for s in t.sources()]
+
+
+__all__ = ["Transfers", "VariationalSystem", "Work"]
