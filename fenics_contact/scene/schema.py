@@ -46,7 +46,10 @@ Deformable bodies in one mesh replace [material] and [contact] by::
 
     [[body]]     name, tag (cell tag), law, E, nu      (one per body)
     [[pair]]     name, striker, target (facet tags), r, relative,
-                 mu, tangential_r_max (Coulomb friction, as in [contact])
+                 mu, tangential_r_max (Coulomb friction, as in [contact]),
+                 self_contact = true (the target on the striker's own body; target
+                 defaults to striker; one [[body]] is then enough), neighbourhood
+                 (facet sizes along the surface a node does not search; default 3)
     [[obstacle]] as above, its tag on the facets of one body
 
 In every scene a [[dirichlet]] may give path = [[t, ux, uy], ...] (a
@@ -230,8 +233,14 @@ def _bodies(path: Path, data: dict[str, Any]) -> tuple[BodySpec, ...]:
 def _pairs(path: Path, data: dict[str, Any]) -> tuple[PairSpec, ...]:
     out = []
     for reader in _array(path, data, "pair"):
+        self_contact = reader.flag("self_contact", False)
+        if self_contact:  # one surface against itself: the target defaults to the striker
+            reader.table.setdefault("target", reader.table.get("striker"))
+        elif "neighbourhood" in reader.table:
+            raise reader.fail("neighbourhood", "belongs to self-contact: add self_contact = true "
+                              "or remove neighbourhood.")
         for key in ("striker", "target"):
-            if key not in reader.table:
+            if reader.table.get(key) is None:
                 raise SceneError(
                     f"{path.name}: [[pair]] needs '{key}', the facet tag of the {key} surface "
                     "(a number or a physical curve/surface name)."
@@ -242,6 +251,8 @@ def _pairs(path: Path, data: dict[str, Any]) -> tuple[PairSpec, ...]:
             r=_contact_r(reader), relative=reader.flag("relative", True),
             mu=_friction(reader),
             tangential_r_max=reader.number("tangential_r_max", 2.0, positive=True),
+            self_contact=self_contact,
+            neighbourhood=reader.number("neighbourhood", 3.0, positive=True),
         ))
     return tuple(out)
 
@@ -514,9 +525,10 @@ def _two_body_scene(path: Path, data: dict[str, Any], head: _Reader, dimension: 
     bodies = _bodies(path, data)
     pairs = _pairs(path, data)
     obstacles = _obstacle_blocks(path, data, dimension)
-    if len(bodies) < 2:
+    if len(bodies) < 2 and not any(p.self_contact for p in pairs):
         raise SceneError(f"{path.name}: {len(bodies)} [[body]] block(s); a contact pair needs "
-                         "two bodies: add a [[body]] per body (name, tag, law, E, nu).")
+                         "two bodies: add a [[body]] per body (name, tag, law, E, nu), or "
+                         "self_contact = true in [[pair]] for a surface touching its own body.")
     if not pairs:
         raise SceneError(f"{path.name}: no [[pair]] block; add one with striker and target "
                          "facet tags.")
