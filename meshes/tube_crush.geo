@@ -6,7 +6,8 @@
 // Physical groups:
 //   Surface "tube" = 1                                                   (cell tags)
 //   Curve "outer_bottom" = 1, "outer_top" = 2 (the outer quarters),
-//   "inner" = 3 (the inner half circle), "cut" = 4 (the wall at x = 0)    (facet tags)
+//   "inner_bottom" = 3, "inner_top" = 5 (the inner quarters), "cut" = 4 (the
+//   wall at x = 0)                                                       (facet tags)
 
 DefineConstant[
   R_out = {1.0, Name "Parameters/outer radius"},
@@ -41,5 +42,6 @@ Transfinite Surface {2} = {3, 4, 7, 6};
 Physical Surface("tube", 1) = {1, 2};
 Physical Curve("outer_bottom", 1) = {1};
 Physical Curve("outer_top", 2) = {2};
-Physical Curve("inner", 3) = {3, 4};
+Physical Curve("inner_bottom", 3) = {3};
+Physical Curve("inner_top", 5) = {4};
 Physical Curve("cut", 4) = {5, 7};

@@ -342,7 +342,7 @@ class NodeToSegmentContact(Contact):
             from fenics_contact.model.self_contact import SelfContactPair
 
             self.pair = SelfContactPair(solid.V, solid.u, self.surface, self.target_facets,
-                                        self.neighbourhood)
+                                        self.facets, self.neighbourhood)
         else:
             self.pair = DeformablePair(solid.V, solid.u, self.surface, self.target_facets)
         self.pair.refresh()
