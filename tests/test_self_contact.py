@@ -1,7 +1,7 @@
 """Self-contact: the search that skips a node's neighbourhood, and the crushed tube scene.
 
 ``scenes/tube_crush.toml`` (half model, neo-Hookean, R_out = 1, wall 0.1,
-3 x 40 x 2 triangles through and along the wall) is flattened between two
+4 x 54 x 2 triangles through and along the wall) is flattened between two
 rigid plates until the upper inner quarter closes on the lower one (a
 self-contact [[pair]] of the tube with itself).
 """

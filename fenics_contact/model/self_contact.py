@@ -14,7 +14,9 @@ wall: on a convex wall it lies behind their straight extension (a false
 penetration), on a concave one in front by the sagitta only (a false
 contact once the wall flattens). A facet also counts only while the node
 lies in front of its plane or behind it by less than ``depth`` facet sizes:
-the far side of a closed convex surface faces a node too, from inside. A
+the far side of a closed convex surface faces a node too, from inside;
+and only while the node's projection falls on it or within half a facet
+of it (the straight extension of a facet far from the node is no surface). A
 node that no facet qualifies for keeps the non-excluded facet with the
 largest signed distance (its distance is reported infinite) and its gap
 is lifted by a length far beyond the surface (:attr:`SelfContactPair.lift`),
@@ -39,6 +41,8 @@ from fenics_contact.model.search import KEEP, TIE_TOL, Projection, facet_normals
 NEIGHBOURHOOD = 3.0
 #: Search depth behind a facet's plane, in mean facet sizes.
 DEPTH = 1.0
+#: Largest overshoot of a projection past its facet (local coordinate) for the facet to count.
+OVER = 0.5
 
 
 def _surface_graph(X: np.ndarray, facet_vertex: np.ndarray) -> tuple[csr_matrix, float]:
@@ -125,13 +129,13 @@ def closest_facing(
     # in front of the facet's plane, or behind it by less than the search depth
     size = float(np.mean(np.linalg.norm(current[:, 1] - current[:, 0], axis=-1)))
     signed = np.einsum("ijd,jd->ij", points[:, None, :] - current[None, :, 0], normals)
-    valid = allowed & (facing | no_rule[:, None]) & (signed > -depth * size)
+    xi, dist, over = project(points, np.broadcast_to(current, (n, *current.shape)))
+    valid = allowed & (facing | no_rule[:, None]) & (signed > -depth * size) & (over <= OVER)
     if not np.all(allowed.any(axis=1)):
         raise ValueError(
             "A self-contact node excludes every facet of the surface; lower the neighbourhood "
             "or refine the surface."
         )
-    xi, dist, over = project(points, np.broadcast_to(current, (n, *current.shape)))
     key = np.where(valid, dist, np.inf)
     best = key.min(axis=1, keepdims=True)
     tie = np.where(valid & (key <= best + TIE_TOL * size), over, np.inf)
