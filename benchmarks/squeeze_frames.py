@@ -68,7 +68,8 @@ def squeeze(scene: Scene) -> tuple[object, object, list[Frame]]:
 
 
 def draw(frames: list[Frame], path: Path, *, mirror: bool, title: str, labels: list[str],
-         curve: tuple[np.ndarray, list[tuple[np.ndarray, str]], str, str] | None = None) -> None:
+         curve: tuple[np.ndarray, list[tuple[np.ndarray, str]], str, str] | None = None,
+         log: bool = False) -> None:
     """Deformed sections side by side, the contact nodes coloured by |pressure|, and a curve."""
     import matplotlib
 
@@ -101,6 +102,8 @@ def draw(frames: list[Frame], path: Path, *, mirror: bool, title: str, labels: l
             ax.plot(x, y, "o-" if "FE" in name else "--", label=name, ms=3)
         ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
+        if log:
+            ax.set_yscale("log")
         ax.legend(fontsize=8)
         ax.grid(alpha=0.3)
     fig.suptitle(title, fontsize=10)

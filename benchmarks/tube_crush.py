@@ -8,7 +8,7 @@ and reports the self-contact penetration and the balance of the plates.
 Writes results/bench/tube_crush.json and docs/images/tube_crush.png
 (crushed sections coloured by contact pressure, force-travel curves).
 
-Run: ``python benchmarks/tube_crush.py [--refine 2] [--out results/bench]``.
+Run: ``python benchmarks/tube_crush.py [--refine 2] [--n-t 4 --n-q 54] [--out results/bench]``.
 """
 
 from __future__ import annotations
@@ -45,12 +45,15 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scene", type=Path, default=Path("scenes/tube_crush.toml"))
     parser.add_argument("--refine", type=int, default=2)
+    parser.add_argument("--n-t", type=int, help="layers through the wall (default: the scene's)")
+    parser.add_argument("--n-q", type=int, help="divisions along a quarter (default: the scene's)")
     parser.add_argument("--out", type=Path, default=Path("results/bench"))
     parser.add_argument("--image", type=Path, default=Path("docs/images/tube_crush.png"))
     args = parser.parse_args()
     scene = load_scene(args.scene)
     travel = -scene.obstacles[1].obstacle.motion[1]
     params = dict(scene.mesh.parameters)
+    params.update({k: v for k, v in (("n_t", args.n_t), ("n_q", args.n_q)) if v is not None})
     fine = {k: args.refine * v for k, v in params.items()}
     runs = {}
     for label, p in (("coarse", params), ("fine", fine)):
@@ -87,7 +90,7 @@ def main() -> None:
          title="Tube crushed between two plates: plates and self-contact of the inner wall",
          labels=[f"travel {travel * shown[i].t:.3f}" for i in picks],
          curve=(travel * t, [(np.array(c["top"]), "FE coarse"), (np.array(f["top"]), "FE fine")],
-                "plate travel", "plate force"))
+                "plate travel", "plate force"), log=True)
     print(f"wrote {args.image} and {args.out / 'tube_crush.json'}")
 
 
