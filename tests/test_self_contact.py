@@ -132,3 +132,15 @@ def test_self_contact_mistakes_are_named(tmp_path):
     path.write_text(text.replace("neighbourhood = 3.0", "neighbourhood = -1.0"))
     with pytest.raises(SceneError, match="neighbourhood"):
         load_scene(path)
+
+
+@pytest.mark.mpi
+def test_the_crushed_tube_is_the_same_on_every_process_count(tmp_path):
+    """Serial: plate force 8.746237917560 and 49 inner nodes in contact (2 ranks: the same)."""
+    out = Path(MPI.COMM_WORLD.bcast(str(tmp_path), root=0)) / "out"
+    outcome = run_scene(load_scene(SCENE), out, pictures=False)
+    assert outcome.path.converged
+    states = outcome.problem.contact_states()
+    assert states["top"].contact_force == pytest.approx(8.746237917560, rel=1e-8)
+    assert states["inner"].active_count == 49
+    assert states["inner"].max_penetration <= 1e-8 * WALL
