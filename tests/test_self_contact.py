@@ -144,3 +144,16 @@ def test_the_crushed_tube_is_the_same_on_every_process_count(tmp_path):
     assert states["top"].contact_force == pytest.approx(8.746237917560, rel=1e-8)
     assert states["inner"].active_count == 49
     assert states["inner"].max_penetration <= 1e-8 * WALL
+
+
+def test_a_self_contact_pair_on_two_bodies_is_refused(tmp_path):
+    from fenics_contact.scene.build import build_problem
+
+    shipped = SCENE.parent / "cylinder_between_plates.toml"
+    text = shipped.read_text().replace('"../meshes/', f'"{SCENE.parent.parent / "meshes"}/')
+    path = tmp_path / "cbp.toml"
+    path.write_text(text.replace('target = "right_side"\n',
+                                 'target = "right_side"\nself_contact = true\n'))
+    with pytest.raises(SceneError, match=r"\[\[pair\]\] 'side' has self_contact = true, but "
+                       r"striker = 'left_side' and target = 'right_side' lie on bodies"):
+        build_problem(load_scene(path), MPI.COMM_SELF)
