@@ -64,9 +64,12 @@ def main() -> None:
         if label == "coarse":
             shown = frames
     c, f = runs["coarse"], runs["fine"]
-    t = np.array(c["t"])
-    rel = np.abs(np.array(c["top"]) - np.array(f["top"])) / np.array(f["top"])
-    before = (np.array(c["inner_active"]) == 0) & (np.array(f["inner_active"]) == 0)
+    # compare at the load factors both runs reached (a run may stop early)
+    n = min(len(c["t"]), len(f["t"]))
+    t = np.array(c["t"][:n])
+    assert np.allclose(t, f["t"][:n]), "the two runs took different load steps"
+    rel = np.abs(np.array(c["top"][:n]) - np.array(f["top"][:n])) / np.array(f["top"][:n])
+    before = (np.array(c["inner_active"][:n]) == 0) & (np.array(f["inner_active"][:n]) == 0)
     record = {
         **runs, "travel": travel,
         "before_touch_max_difference": float(rel[before].max()),
@@ -77,7 +80,8 @@ def main() -> None:
     }
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "tube_crush.json").write_text(json.dumps(record, indent=1))
-    print(f"coarse {params}, fine {fine}")
+    print(f"coarse {params}, fine {fine}; converged: {c['converged']}, {f['converged']} "
+          f"({len(c['t'])} and {len(f['t'])} steps)")
     print(f"plate force, before the inner wall touches: max difference {rel[before].max():.2%}")
     if np.any(~before):
         print(f"after: {rel[~before].max():.2%} (load factors {t[~before].round(3).tolist()})")
@@ -89,7 +93,8 @@ def main() -> None:
     draw([shown[i] for i in picks], args.image, mirror=True,
          title="Tube crushed between two plates: plates and self-contact of the inner wall",
          labels=[f"travel {travel * shown[i].t:.3f}" for i in picks],
-         curve=(travel * t, [(np.array(c["top"]), "FE coarse"), (np.array(f["top"]), "FE fine")],
+         curve=(travel * t, [(np.array(c["top"][:n]), "FE coarse"),
+                             (np.array(f["top"][:n]), "FE fine")],
                 "plate travel", "plate force"), log=True)
     print(f"wrote {args.image} and {args.out / 'tube_crush.json'}")
 
