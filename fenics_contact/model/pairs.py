@@ -232,7 +232,7 @@ class DeformablePair:
         self._searched_u = self.u.x.array.copy()
         w_t = self.target_displacements()
         current = (self.X_vertices + w_t)[self.facet_vertex]
-        proj = SurfaceSearch(current).closest(self.striker_positions(), previous=self.assignment)
+        proj = self._search(current)
         self.search_count += 1
         self.projection = proj
         facet = proj.facet
@@ -247,6 +247,10 @@ class DeformablePair:
         if changed:
             self.version += 1
         return changed
+
+    def _search(self, current: np.ndarray):
+        """Closest target facet of every striker node (current facet vertices given)."""
+        return SurfaceSearch(current).closest(self.striker_positions(), previous=self.assignment)
 
     def penetration(self) -> np.ndarray:
         """Depth of each owned striker node inside the current target surface (length, >= 0).
@@ -284,6 +288,10 @@ class NodeToSegmentContact(Contact):
         target: the target's body (likewise).
         friction: Coulomb friction (None: frictionless); see :meth:`slip_increment`.
         name: label in outputs.
+        self_contact: the target is the striker's own body (the facet sets may be
+            one): each node's neighbourhood along the surface is excluded from its
+            search and only facets facing it count (:mod:`.self_contact`).
+        neighbourhood: radius of that neighbourhood in facet sizes.
     """
 
     def __init__(
@@ -296,6 +304,8 @@ class NodeToSegmentContact(Contact):
         target: str | None = None,
         friction: FrictionSettings | None = None,
         name: str = "pair",
+        self_contact: bool = False,
+        neighbourhood: float = 3.0,
     ) -> None:
         if settings.quadrature != "nodal":
             raise ValueError(
@@ -305,6 +315,8 @@ class NodeToSegmentContact(Contact):
         super().__init__(striker_facets, settings, friction=friction, name=name)
         self.target_facets = np.asarray(target_facets, dtype=np.int32)
         self._names = (striker, target)
+        self.self_contact = self_contact
+        self.neighbourhood = neighbourhood
         self._target_force_forms: list[fem.Form] | None = None
 
     def _bind_partner(self, solid) -> ufl.core.expr.Expr:
@@ -313,7 +325,7 @@ class NodeToSegmentContact(Contact):
                 f"Two-body contact needs degree = 1 (vertex node-to-segment), got {solid.degree}."
             )
         overlap = np.intersect1d(self.facets, self.target_facets).size
-        if self.comm.allreduce(overlap, op=MPI.SUM):
+        if not self.self_contact and self.comm.allreduce(overlap, op=MPI.SUM):
             raise ValueError(
                 "The striker and target facet sets share facets; a contact pair needs two "
                 "disjoint surfaces (tag them separately)."
@@ -326,7 +338,13 @@ class NodeToSegmentContact(Contact):
         Es, Et = (b.material.E for b in bodies)
         self.striker_body, self.target_body = bodies
         self.modulus = 2.0 * Es * Et / (Es + Et)
-        self.pair = DeformablePair(solid.V, solid.u, self.surface, self.target_facets)
+        if self.self_contact:
+            from fenics_contact.model.self_contact import SelfContactPair
+
+            self.pair = SelfContactPair(solid.V, solid.u, self.surface, self.target_facets,
+                                        self.facets, self.neighbourhood)
+        else:
+            self.pair = DeformablePair(solid.V, solid.u, self.surface, self.target_facets)
         self.pair.refresh()
         return self.pair.gap(ufl.SpatialCoordinate(solid.domain) + solid.u)
 

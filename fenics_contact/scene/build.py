@@ -347,7 +347,8 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
                     else FrictionSettings(pair.mu, pair.tangential_r_max))
         contacts.append(NodeToSegmentContact(
             striker, target, ContactSettings(r=pair.r, relative=pair.relative),
-            friction=friction, name=pair.name))
+            friction=friction, name=pair.name, self_contact=pair.self_contact,
+            neighbourhood=pair.neighbourhood))
     contacts += [obstacle_contact(scene, body, entry, bodies) for entry in scene.obstacles]
     solid = Solid(body.domain, bodies, body.cell_tags, prescribed=prescribed,
                   tractions=tractions)

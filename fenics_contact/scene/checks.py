@@ -153,11 +153,21 @@ def check_pair_surfaces(
                 "so each contact surface is a boundary."
             )
         owners[role] = facet_owners(domain, cell_tags, bodies, facets)
+    if pair.self_contact:
+        if len(owners["striker"]) != 1 or owners["striker"] != owners["target"]:
+            raise SceneError(
+                f"{scene.path.name}: [[pair]] '{pair.name}' has self_contact = true, but striker "
+                f"= {pair.striker!r} and target = {pair.target!r} lie on bodies "
+                f"{owners['striker'] + owners['target']}; give facets of one body, or remove "
+                "self_contact for a pair of two bodies."
+            )
+        return
     if owners["striker"] == owners["target"] and len(owners["striker"]) == 1:
         raise SceneError(
             f"{scene.path.name}: [[pair]] striker = {pair.striker!r} and target = "
             f"{pair.target!r} both lie on body {owners['striker'][0]!r}; a pair joins two "
-            "bodies: give the target surface of the other body."
+            "bodies: give the target surface of the other body (or self_contact = true for "
+            "self-contact)."
         )
 
 

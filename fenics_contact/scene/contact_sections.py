@@ -155,8 +155,14 @@ def read_pairs(path: Path, data: dict[str, Any]) -> tuple[PairSpec, ...]:
     """The [[pair]] blocks: striker and target facet tags, r and friction per pair."""
     out = []
     for reader in _array(path, data, "pair"):
+        self_contact = reader.flag("self_contact", False)
+        if self_contact:  # one surface against itself: the target defaults to the striker
+            reader.table.setdefault("target", reader.table.get("striker"))
+        elif "neighbourhood" in reader.table:
+            raise reader.fail("neighbourhood", "belongs to self-contact: add self_contact = true "
+                              "or remove neighbourhood.")
         for key in ("striker", "target"):
-            if key not in reader.table:
+            if reader.table.get(key) is None:
                 raise SceneError(
                     f"{path.name}: [[pair]] needs '{key}', the facet tag of the {key} surface "
                     "(a number or a physical curve/surface name)."
@@ -167,6 +173,8 @@ def read_pairs(path: Path, data: dict[str, Any]) -> tuple[PairSpec, ...]:
             r=_contact_r(reader), relative=reader.flag("relative", True),
             mu=_friction(reader),
             tangential_r_max=reader.number("tangential_r_max", 2.0, positive=True),
+            self_contact=self_contact,
+            neighbourhood=reader.number("neighbourhood", 3.0, positive=True),
         ))
     return tuple(out)
 

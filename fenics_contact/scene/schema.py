@@ -47,7 +47,10 @@ Deformable bodies in one mesh replace [material] and [contact] by::
 
     [[body]]     name, tag (cell tag), law, E, nu      (one per body)
     [[pair]]     name, striker, target (facet tags), r, relative,
-                 mu, tangential_r_max (Coulomb friction, as in [contact])
+                 mu, tangential_r_max (Coulomb friction, as in [contact]),
+                 self_contact = true (the target on the striker's own body; target
+                 defaults to striker; one [[body]] is then enough), neighbourhood
+                 (facet sizes along the surface a node does not search; default 3)
     [[obstacle]] as above, its tag on the facets of one body
 
 In every scene a [[dirichlet]] may give path = [[t, ux, uy], ...] (a
@@ -213,9 +216,10 @@ def _two_body_scene(path: Path, data: dict[str, Any], head: _Reader, dimension: 
     bodies = read_bodies(path, data)
     pairs = read_pairs(path, data)
     obstacles = read_obstacle_blocks(path, data, dimension)
-    if len(bodies) < 2:
+    if len(bodies) < 2 and not any(p.self_contact for p in pairs):
         raise SceneError(f"{path.name}: {len(bodies)} [[body]] block(s); a contact pair needs "
-                         "two bodies: add a [[body]] per body (name, tag, law, E, nu).")
+                         "two bodies: add a [[body]] per body (name, tag, law, E, nu), or "
+                         "self_contact = true in [[pair]] for a surface touching its own body.")
     if not pairs:
         raise SceneError(f"{path.name}: no [[pair]] block; add one with striker and target "
                          "facet tags.")

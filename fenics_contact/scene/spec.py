@@ -80,6 +80,10 @@ class PairSpec:
     relative: bool = True
     mu: float | None = None
     tangential_r_max: float | None = 2.0
+    #: The target is the striker's own body (self-contact; see model/self_contact.py).
+    self_contact: bool = False
+    #: Radius of each node's excluded neighbourhood along the surface (facet sizes).
+    neighbourhood: float = 3.0
 
 
 @dataclass(frozen=True)

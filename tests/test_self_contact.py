@@ -1,0 +1,159 @@
+"""Self-contact: the search that skips a node's neighbourhood, and the crushed tube scene.
+
+``scenes/tube_crush.toml`` (half model, neo-Hookean, R_out = 1, wall 0.1,
+4 x 54 x 2 triangles through and along the wall) is flattened between two
+rigid plates until the upper inner quarter closes on the lower one (a
+self-contact [[pair]] of the tube with itself).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import ufl
+from dolfinx import fem, la
+
+from mpi4py import MPI
+
+from fenics_contact.model.search import facet_normals
+from fenics_contact.model.self_contact import closest_facing, neighbourhoods
+from fenics_contact.runner import run_scene
+from fenics_contact.scene.schema import SceneError, load_scene
+
+SCENE = Path(__file__).parent.parent / "scenes" / "tube_crush.toml"
+WALL = 0.1
+
+
+def circle(n: int, radius: float = 1.0, inward: bool = True):
+    """Vertices and facets of a closed polygon; normals point to the centre when inward."""
+    angle = 2 * np.pi * np.arange(n) / n
+    X = radius * np.stack([np.cos(angle), np.sin(angle)], axis=1)
+    facets = np.stack([np.arange(n), (np.arange(n) + 1) % n], axis=1)
+    # perp(b - a) = (t_y, -t_x) points out of a counter-clockwise loop
+    return X, facets if not inward else facets[:, ::-1]
+
+
+def test_the_neighbourhood_is_measured_along_the_surface():
+    X, facets = circle(40)
+    excluded = neighbourhoods(X, facets, np.array([0, 10, -1]), 3.0).toarray()
+    # a vertex touches two facets; 3 facet sizes each way add three more on each side
+    assert excluded[0].sum() == 8 and excluded[1].sum() == 8 and excluded[2].sum() == 0
+    near = {f for f in range(40) if 0 in facets[f] or 1 in facets[f] or 39 in facets[f]}
+    assert near <= set(np.flatnonzero(excluded[0]))
+    # a slit: two faces 1e-3 apart in space but far along the surface exclude nothing of each other
+    Y = np.array([[0, 0], [1, 0], [2, 0], [2, 1e-3], [1, 1e-3], [0, 1e-3]], float)
+    slit = np.array([[0, 1], [1, 2], [2, 3], [3, 4], [4, 5]])
+    far = neighbourhoods(Y, slit, np.array([1]), 1.0).toarray()[0]
+    assert far.tolist() == [True, True, False, False, False]
+
+
+def test_a_node_on_a_curved_wall_sees_only_facets_that_face_it():
+    """Past its neighbourhood a node's own wall reads it inside (convex) or touching (concave)."""
+    Y, outward = circle(40, inward=False)
+    convex = Y[outward]
+    # convex wall: the first facet past the neighbourhood of vertex 0 reads it inside
+    assert np.dot(Y[0] - convex[4, 0], facet_normals(convex)[4]) < 0
+    X, facets = circle(40)
+    current = X[facets]
+    points = X[[0, 5]]
+    normal = facet_normals(current)
+    # concave wall: it reads it open by the sagitta only, closed once the wall flattens
+    assert 0 < np.dot(points[0] - current[4, 0], normal[4]) < 0.25
+    excluded = neighbourhoods(X, facets, np.array([0, 5]), 3.0)
+    proj = closest_facing(points, -points, current, excluded)
+    assert not np.any(excluded.toarray()[[0, 1], proj.facet])
+    assert np.all(np.einsum("ij,ij->i", normal[proj.facet], -points) < 0)  # facing
+    gap = np.einsum("ij,ij->i", points - current[proj.facet, 0], normal[proj.facet])
+    assert np.all(gap > 0.9)  # open: the facing facets lie half a circle away
+    # a closed circle seen from outside (normals outward): nothing faces a node, it stays open
+    lonely = closest_facing(Y[[0]], Y[[0]], convex, neighbourhoods(Y, outward, np.array([0]), 3.0))
+    assert lonely.distance[0] == np.inf  # no partner: the pair lifts its gap (stays open)
+
+
+@pytest.fixture(scope="module")
+def crushed(tmp_path_factory):
+    out = tmp_path_factory.mktemp("tube") / "out"
+    return run_scene(load_scene(SCENE), out, comm=MPI.COMM_SELF, pictures=False)
+
+
+def test_the_inner_wall_closes_without_penetration(crushed):
+    assert crushed.path.converged
+    steps = crushed.summary["steps"]
+    inner = [s["contacts"]["inner"] for s in steps]
+    assert max(s["max_penetration"] for s in inner) <= 1e-8 * WALL
+    first = next(i for i, s in enumerate(inner) if s["active_count"] > 0)
+    assert first > 40 and inner[-1]["active_count"] >= 30  # closes late, then spreads
+    # the plates take the crushing force; the wall contact carries most of it at the end
+    last = steps[-1]["contacts"]
+    assert 0.7 * last["top"]["normal_force"] < last["inner"]["normal_force"]
+    state = crushed.problem.contact_states()["inner"]
+    assert state.max_penetration <= 1e-8 * WALL
+
+
+def test_every_force_balances(crushed):
+    """Plates (vertical) and the self-contact's two sides (they cancel) to 1e-10."""
+    problem = crushed.problem
+    states = problem.contact_states()
+    top, bottom = states["top"].contact_force, states["bottom"].contact_force
+    assert abs(top - bottom) <= 1e-10 * top
+    contact = next(c for c in problem.contacts if c.name == "inner")
+    v = ufl.TestFunction(problem.V)
+    form = fem.form(ufl.derivative(contact.lagrangian(), problem.u, v),
+                    entity_maps=contact.surface.entity_maps)
+    vec = fem.assemble_vector(form)
+    vec.scatter_reverse(la.InsertMode.add)
+    n = problem.V.dofmap.index_map.size_local
+    on_striker = -vec.array[: 2 * n].reshape(-1, 2).sum(axis=0)
+    on_target = contact.target_force().x.array[: 2 * n].reshape(-1, 2).sum(axis=0)
+    # the upper quarter is pushed up by the lower one
+    assert on_striker[1] > 0.9 * states["inner"].contact_force
+    assert np.allclose(on_striker + on_target, 0.0, rtol=0, atol=1e-10 * top)
+
+
+def test_no_node_is_assigned_a_facet_of_its_own_neighbourhood(crushed):
+    pair = next(c for c in crushed.problem.contacts if c.name == "inner").pair
+    rows = np.arange(pair.n_owned)
+    assert not np.any(pair.excluded.toarray()[rows, pair.assignment[rows]])
+    # the fold: the quarters meet there, so those nodes exclude facets of the target
+    assert pair.excluded.sum(axis=1).max() >= 3
+
+
+def test_self_contact_mistakes_are_named(tmp_path):
+    text = SCENE.read_text().replace('"../meshes/', f'"{SCENE.parent.parent / "meshes"}/')
+    path = tmp_path / "tube.toml"
+    path.write_text(text.replace("self_contact = true\n", ""))
+    with pytest.raises(SceneError, match=r"neighbourhood.*self_contact = true"):
+        load_scene(path)
+    path.write_text(text.replace("self_contact = true\nneighbourhood = 3.0\n", ""))
+    with pytest.raises(SceneError, match=r"a contact pair needs two bodies.*self_contact = true"):
+        load_scene(path)
+    path.write_text(text.replace("neighbourhood = 3.0", "neighbourhood = -1.0"))
+    with pytest.raises(SceneError, match="neighbourhood"):
+        load_scene(path)
+
+
+@pytest.mark.mpi
+def test_the_crushed_tube_is_the_same_on_every_process_count(tmp_path):
+    """Serial: plate force 8.746237917560 and 49 inner nodes in contact (2 ranks: the same)."""
+    out = Path(MPI.COMM_WORLD.bcast(str(tmp_path), root=0)) / "out"
+    outcome = run_scene(load_scene(SCENE), out, pictures=False)
+    assert outcome.path.converged
+    states = outcome.problem.contact_states()
+    assert states["top"].contact_force == pytest.approx(8.746237917560, rel=1e-8)
+    assert states["inner"].active_count == 49
+    assert states["inner"].max_penetration <= 1e-8 * WALL
+
+
+def test_a_self_contact_pair_on_two_bodies_is_refused(tmp_path):
+    from fenics_contact.scene.build import build_problem
+
+    shipped = SCENE.parent / "cylinder_between_plates.toml"
+    text = shipped.read_text().replace('"../meshes/', f'"{SCENE.parent.parent / "meshes"}/')
+    path = tmp_path / "cbp.toml"
+    path.write_text(text.replace('target = "right_side"\n',
+                                 'target = "right_side"\nself_contact = true\n'))
+    with pytest.raises(SceneError, match=r"\[\[pair\]\] 'side' has self_contact = true, but "
+                       r"striker = 'left_side' and target = 'right_side' lie on bodies"):
+        build_problem(load_scene(path), MPI.COMM_SELF)
