@@ -57,11 +57,13 @@ def _perp(t: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
 class MortarTransfer:
     """Striker neighbours and target slots of every striker node; the selection w = S u.
 
-    Coefficients on the striker submesh (vector P1 ``W``, scalar P1 ``Q``):
-    reference positions ``X_*`` and displacements ``w_*`` of the left and
-    right neighbours and of each slot's target facet ends (a_k, b_k), and
-    masks ``m_*`` (1 where the facet or slot exists). Unused slots point at
-    the node itself with mask 0.
+    Coefficients on the striker submesh, one row per point of a node's
+    stencil (row 0: the left neighbour, 1: the right one, 2 + 2k and
+    3 + 2k: the ends a_k, b_k of slot k's target facet): reference positions
+    ``X`` and displacements ``w`` (P1, shape (rows, 2)), and masks ``m``
+    (P1, shape (2 + slots,): 1 where the neighbour or the slot exists).
+    Unused slots point at the node itself with mask 0. One packed
+    coefficient keeps the Jacobian at 3 x 3 blocks.
     """
 
     def __init__(self, V: fem.FunctionSpace, u: fem.Function, surface: ContactSurface,
@@ -70,14 +72,17 @@ class MortarTransfer:
         self.striker = Polyline(V, surface.facets)
         self.target = Polyline(V, target_facets)
         self.slots = slots or default_slots(self.striker, self.target)
+        self.rows = 2 + 2 * self.slots
         self.reach = 2.0 * max(float(np.max(facet_sizes(self.striker))),
                                float(np.max(facet_sizes(self.target))))
-        self.W = fem.functionspace(surface.submesh, ("Lagrange", 1, (2,)))
+        sub = surface.submesh
+        self.W = fem.functionspace(sub, ("Lagrange", 1, (self.rows, 2)))
+        self.M = fem.functionspace(sub, ("Lagrange", 1, (2 + self.slots,)))
         Q = surface.Q
-        if not np.array_equal(self.W.dofmap.list, Q.dofmap.list):
-            raise RuntimeError("The vector and scalar P1 submesh spaces number nodes differently.")
-        sub_geo = surface.submesh.geometry
-        parent = np.asarray(surface.node_map)[sub_geo.dofmaps[0].reshape(-1)]
+        if not (np.array_equal(self.W.dofmap.list, Q.dofmap.list)
+                and np.array_equal(self.M.dofmap.list, Q.dofmap.list)):
+            raise RuntimeError("The blocked and scalar P1 submesh spaces number nodes differently.")
+        parent = np.asarray(surface.node_map)[sub.geometry.dofmaps[0].reshape(-1)]
         n_w = self.W.dofmap.index_map.size_local + self.W.dofmap.index_map.num_ghosts
         node = np.zeros(n_w, np.int64)
         node[self.W.dofmap.list.reshape(-1)] = parent
@@ -89,43 +94,29 @@ class MortarTransfer:
         if np.any((left < 0) & (right < 0)):
             raise ValueError("A striker node of a mortar pair has no striker facet.")
         self.sides = (left, right)
-
-        def vec(name: str) -> fem.Function:
-            return fem.Function(self.W, name=name)
-
-        def scal(name: str) -> fem.Function:
-            return fem.Function(Q, name=name)
-
-        self.X_side = [vec("mortar_X_left"), vec("mortar_X_right")]
-        self.w_side = [vec("mortar_w_left"), vec("mortar_w_right")]
-        self.m_side = [scal("mortar_m_left"), scal("mortar_m_right")]
-        self.X_slot = [[vec(f"mortar_X{e}{k}") for e in "ab"] for k in range(self.slots)]
-        self.w_slot = [[vec(f"mortar_w{e}{k}") for e in "ab"] for k in range(self.slots)]
-        self.m_slot = [scal(f"mortar_m{k}") for k in range(self.slots)]
+        self.X = fem.Function(self.W, name="mortar_X")
+        self.w = fem.Function(self.W, name="mortar_w")
+        self.m = fem.Function(self.M, name="mortar_mask")
+        self._X = np.zeros((n_w, self.rows, 2))
+        self._m = np.zeros((n_w, 2 + self.slots))
+        self._src = np.zeros((n_w, self.rows), np.int64)
+        self._idx = np.zeros((n_w, 2), np.int64)
+        Xs = self.striker.X
+        Xj = Xs[self.me]
+        for s, (nb, other) in enumerate(((left, right), (right, left))):
+            has = nb >= 0
+            self._X[:, s] = np.where(has[:, None], Xs[np.maximum(nb, 0)],
+                                     2.0 * Xj - Xs[np.maximum(other, 0)])
+            self._m[:, s] = has
+            self._idx[:, s] = np.where(has, nb, self.me)
+            self._src[:, s] = self.striker.vertices[self._idx[:, s]]
         self.assignment = np.full((n_w, self.slots), -2, np.int64)
-        self._sources: list[np.ndarray] = []
         self.version = 0
         self.search_count = 0
         self._searched_u: np.ndarray | None = None
-        self._fill_sides()
-
-    def _fill_sides(self) -> None:
-        """Reference positions, masks and sources of the striker neighbours (fixed)."""
-        X = self.striker.X
-        Xj = X[self.me]
-        left, right = self.sides
-        self._side_src, self._side_idx = [], []
-        for s, (nb, other) in enumerate(((left, right), (right, left))):
-            has = nb >= 0
-            Xn = np.where(has[:, None], X[np.maximum(nb, 0)], 2.0 * Xj - X[np.maximum(other, 0)])
-            self.X_side[s].x.array[:] = Xn.reshape(-1)
-            self.m_side[s].x.array[:] = has.astype(float)
-            idx = np.where(has, nb, self.me)
-            self._side_idx.append(idx)
-            self._side_src.append(self.striker.vertices[idx])
 
     def refresh(self) -> bool:
-        """Search the slots and fill the w_*; True when some slot changed (any rank)."""
+        """Search the slots and fill X, w and m; True when some slot changed (any rank)."""
         same = self._searched_u is not None and np.array_equal(self._searched_u, self.u.x.array)
         if not any_rank(self.comm, not same):
             return False
@@ -135,7 +126,7 @@ class MortarTransfer:
         xs = self.striker.X + us
         xt = (self.target.X + ut)[self.target.facet_vertex]
         xj = xs[self.me]
-        x_side = [xs[i] for i in self._side_idx]
+        x_side = [xs[self._idx[:, s]] for s in (0, 1)]
         x_side = [np.where((self.sides[s] >= 0)[:, None], x_side[s], 2 * xj - x_side[1 - s])
                   for s in (0, 1)]
         scores = np.full((xj.shape[0], xt.shape[0]), -np.inf)
@@ -145,21 +136,23 @@ class MortarTransfer:
             scores = np.maximum(scores, sc)
         facet, used = pick_slots(scores, self.slots)
         self.search_count += 1
-        for s in (0, 1):
-            self.w_side[s].x.array[:] = us[self._side_idx[s]].reshape(-1)
+        w = np.zeros_like(self._X)
+        w[:, 0], w[:, 1] = us[self._idx[:, 0]], us[self._idx[:, 1]]
         fv = self.target.facet_vertex
-        sources = []
         for k in range(self.slots):
             f = np.maximum(facet[:, k], 0)
-            self.m_slot[k].x.array[:] = used[:, k].astype(float)
+            on = used[:, k]
+            self._m[:, 2 + k] = on
             for e in (0, 1):
                 vert = fv[f, e]
-                X = np.where(used[:, k, None], self.target.X[vert], self.striker.X[self.me])
-                w = np.where(used[:, k, None], ut[vert], us[self.me])
-                self.X_slot[k][e].x.array[:] = X.reshape(-1)
-                self.w_slot[k][e].x.array[:] = w.reshape(-1)
-                sources.append(np.where(used[:, k], self.target.vertices[vert], self.block))
-        self._sources = [self._side_src[0], self._side_src[1], *sources]
+                row = 2 + 2 * k + e
+                self._X[:, row] = np.where(on[:, None], self.target.X[vert],
+                                           self.striker.X[self.me])
+                w[:, row] = np.where(on[:, None], ut[vert], us[self.me])
+                self._src[:, row] = np.where(on, self.target.vertices[vert], self.block)
+        self.X.x.array[:] = self._X.reshape(-1)
+        self.w.x.array[:] = w.reshape(-1)
+        self.m.x.array[:] = self._m.reshape(-1)
         changed = not np.array_equal(facet[: self.n_owned], self.assignment[: self.n_owned])
         self.assignment = facet
         if any_rank(self.comm, changed):
@@ -167,29 +160,31 @@ class MortarTransfer:
             return True
         return False
 
-    def extras(self) -> list[fem.Function]:
-        """Displacement coefficients selected from u, in the order of :meth:`sources`."""
-        return [*self.w_side, *(w for pair in self.w_slot for w in pair)]
-
     def sources(self) -> list[np.ndarray]:
-        """Global V block each owned W block selects, one array per extra."""
-        return [s[: self.n_owned] for s in self._sources]
+        """Global V block of each row of each owned node, shape (n_owned, rows)."""
+        return [self._src[: self.n_owned].copy()]
 
     # -- UFL -------------------------------------------------------------------------
-    def nodal_gap(self, x_j: ufl.core.expr.Expr, g_open: float) -> ufl.core.expr.Expr:
-        """G_j = g~_j / A~_j at a striker node of current position ``x_j`` (length)."""
-        x_side = [X + w for X, w in zip(self.X_side, self.w_side, strict=True)]
-        facets = ((self.X_side[0], x_side[0], x_j, self.m_side[0], lambda xi: xi),
-                  (self.X_side[1], x_j, x_side[1], self.m_side[1], lambda xi: 1.0 - xi))
-        targets = [(Xa + wa, Xb + wb, m) for (Xa, Xb), (wa, wb), m
-                   in zip(self.X_slot, self.w_slot, self.m_slot, strict=True)]
-        weighted, area = 0, 0
-        for X_nb, x1, x2, m_f, shape in facets:
+    def _point(self, f: fem.Function, i: int) -> ufl.core.expr.Expr:
+        return ufl.as_vector((f[i, 0], f[i, 1]))
+
+    def nodal_gap(self, X_j: ufl.core.expr.Expr, x_j: ufl.core.expr.Expr,
+                  g_open: float) -> ufl.core.expr.Expr:
+        """G_j = g~_j / A~_j at a striker node (reference ``X_j``, current ``x_j``; length)."""
+        X_nb = [self._point(self.X, s) for s in (0, 1)]
+        x_nb = [X_nb[s] + self._point(self.w, s) for s in (0, 1)]
+        facets = ((X_nb[0], x_nb[0], x_j, self.m[0], lambda xi: xi),
+                  (X_nb[1], x_j, x_nb[1], self.m[1], lambda xi: 1.0 - xi))
+        targets = [(self._point(self.X, 2 + 2 * k) + self._point(self.w, 2 + 2 * k),
+                    self._point(self.X, 3 + 2 * k) + self._point(self.w, 3 + 2 * k),
+                    self.m[2 + k]) for k in range(self.slots)]
+        weighted, area, full = 0, 0, 0
+        for Xn, x1, x2, m_f, shape in facets:
             t = x2 - x1
             tt = ufl.dot(t, t)
             n_s = _perp(t) / ufl.sqrt(tt)
-            dX = X_nb - self._X_node
-            length = ufl.sqrt(ufl.dot(dX, dX))
+            length = ufl.sqrt(ufl.dot(Xn - X_j, Xn - X_j))
+            full = full + 0.5 * m_f * length
             for a, b, m_k in targets:
                 xa = ufl.dot(a - x1, t) / tt
                 xb = ufl.dot(b - x1, t) / tt
@@ -204,13 +199,9 @@ class MortarTransfer:
                     weight = m_f * m_k * length * span * wq * shape(xi)
                     weighted = weighted + weight * alpha
                     area = area + weight
-        full = 0.5 * sum(m * ufl.sqrt(ufl.dot(Xn - self._X_node, Xn - self._X_node))
-                         for Xn, m in zip(self.X_side, self.m_side, strict=True))
         floor = 1e-8 * full
         return ufl.conditional(ufl.gt(area, floor),
                                weighted / ufl.max_value(area, floor), g_open)
-
-    _X_node: ufl.core.expr.Expr
 
 
 class MortarContact(Contact):
@@ -261,17 +252,16 @@ class MortarContact(Contact):
         self.mortar = MortarTransfer(solid.V, solid.u, self.surface, self.target_facets,
                                      self._slots)
         X = ufl.SpatialCoordinate(solid.domain)
-        self.mortar._X_node = X
         self.mortar.refresh()
-        return self.mortar.nodal_gap(X + solid.u, float(self.surface.h))
+        return self.mortar.nodal_gap(X, X + solid.u, float(self.surface.h))
 
     def refresh(self) -> bool:
         """Search the slots and refill the coefficients when u has changed."""
         return self.mortar.refresh()
 
     def extras(self) -> list[fem.Function]:
-        """Neighbour and slot displacements (condensed by w = S u)."""
-        return self.mortar.extras()
+        """The packed neighbour and slot displacements (condensed by w = S u)."""
+        return [self.mortar.w]
 
     @property
     def transfer(self) -> MortarTransfer:
@@ -279,14 +269,12 @@ class MortarContact(Contact):
         return self.mortar
 
     def target_force(self) -> fem.Function:
-        """Contact force on the target's vertices, sum over slots of S^T dL_c/dw (force)."""
+        """Contact force on the target's vertices, S^T dL_c/dw over the slot rows (force)."""
         m = self.mortar
         if self._target_force_forms is None:
             q = ufl.TestFunction(m.W)
-            self._target_force_forms = [
-                fem.form(ufl.derivative(self.lagrangian(), w, q),
-                         entity_maps=self.surface.entity_maps)
-                for pair in m.w_slot for w in pair]
+            self._target_force_forms = [fem.form(ufl.derivative(self.lagrangian(), m.w, q),
+                                                 entity_maps=self.surface.entity_maps)]
         m.refresh()
         from petsc4py import PETSc
 
@@ -295,11 +283,12 @@ class MortarContact(Contact):
         vec = PETSc.Vec().createMPI((im.size_local * 2, im.size_global * 2), bsize=2,
                                     comm=self.comm)
         vec.set(0.0)
-        for form, src in zip(self._target_force_forms, m.sources()[2:], strict=True):
-            local = fem.assemble_vector(form)
-            local.scatter_reverse(la.InsertMode.add)
-            values = local.array[: m.n_owned * 2]
-            vec.setValuesBlocked(src.astype(PETSc.IntType), values, addv=PETSc.InsertMode.ADD)
+        local = fem.assemble_vector(self._target_force_forms[0])
+        local.scatter_reverse(la.InsertMode.add)
+        values = local.array[: m.n_owned * m.rows * 2].reshape(m.n_owned, m.rows, 2)[:, 2:]
+        src = m.sources()[0][:, 2:]
+        vec.setValuesBlocked(src.reshape(-1).astype(PETSc.IntType), values.reshape(-1),
+                             addv=PETSc.InsertMode.ADD)
         vec.assemblyBegin()
         vec.assemblyEnd()
         out = fem.Function(V, name="target_contact_force")

@@ -129,8 +129,10 @@ def overlaps(x1: np.ndarray, x2: np.ndarray, ta: np.ndarray, tb: np.ndarray,
     """Overlap (local coordinate of the striker facet) of every target facet with each facet.
 
     Args:
-        x1, x2: (n, 2) current end points of n striker facets.
-        ta, tb: (m, 2) current end points of m target facets.
+        x1: (n, 2) current first end points of n striker facets.
+        x2: (n, 2) their second end points.
+        ta: (m, 2) current first end points of m target facets.
+        tb: (m, 2) their second end points.
         reach: largest |normal distance| of a target facet that counts (length).
 
     Returns (n, m): the length in [0, 1] local coordinates of the projection
