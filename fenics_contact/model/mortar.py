@@ -39,7 +39,6 @@ from fenics_contact.model.contacts import Contact
 from fenics_contact.model.segments import (
     Polyline,
     any_rank,
-    default_slots,
     facet_sizes,
     neighbours,
     node_blocks,
@@ -71,36 +70,39 @@ class MortarTransfer:
         self.V, self.u, self.comm = V, u, V.mesh.comm
         self.striker = Polyline(V, surface.facets)
         self.target = Polyline(V, target_facets)
-        self.slots = slots or default_slots(self.striker, self.target)
-        self.rows = 2 + 2 * self.slots
         self.reach = 2.0 * max(float(np.max(facet_sizes(self.striker))),
                                float(np.max(facet_sizes(self.target))))
         sub = surface.submesh
-        self.W = fem.functionspace(sub, ("Lagrange", 1, (self.rows, 2)))
-        self.M = fem.functionspace(sub, ("Lagrange", 1, (2 + self.slots,)))
         Q = surface.Q
-        if not (np.array_equal(self.W.dofmap.list, Q.dofmap.list)
-                and np.array_equal(self.M.dofmap.list, Q.dofmap.list)):
-            raise RuntimeError("The blocked and scalar P1 submesh spaces number nodes differently.")
         parent = np.asarray(surface.node_map)[sub.geometry.dofmaps[0].reshape(-1)]
-        n_w = self.W.dofmap.index_map.size_local + self.W.dofmap.index_map.num_ghosts
+        n_w = Q.dofmap.index_map.size_local + Q.dofmap.index_map.num_ghosts
         node = np.zeros(n_w, np.int64)
-        node[self.W.dofmap.list.reshape(-1)] = parent
+        node[Q.dofmap.list.reshape(-1)] = parent
         local = node_blocks(V)[node].astype(np.int32)
         self.block = V.dofmap.index_map.local_to_global(local).astype(np.int64)
-        self.n_owned = self.W.dofmap.index_map.size_local
+        self.n_owned = Q.dofmap.index_map.size_local
         self.me = self.striker.index(self.block)
         left, right = neighbours(self.striker, self.me)
         if np.any((left < 0) & (right < 0)):
             raise ValueError("A striker node of a mortar pair has no striker facet.")
         self.sides = (left, right)
+        self._idx = np.stack([np.where(nb >= 0, nb, self.me) for nb in self.sides], axis=1)
+        if slots is None:  # what the reference configuration needs, and one more
+            need = np.sum(self._scores(self.striker.X, self.target.X) > 0.0, axis=1)
+            slots = max(3, int(self.comm.allreduce(int(np.max(need, initial=0)), op=MPI.MAX)) + 1)
+        self.slots = int(slots)
+        self.rows = 2 + 2 * self.slots
+        self.W = fem.functionspace(sub, ("Lagrange", 1, (self.rows, 2)))
+        self.M = fem.functionspace(sub, ("Lagrange", 1, (2 + self.slots,)))
+        if not (np.array_equal(self.W.dofmap.list, Q.dofmap.list)
+                and np.array_equal(self.M.dofmap.list, Q.dofmap.list)):
+            raise RuntimeError("The blocked and scalar P1 submesh spaces number nodes differently.")
         self.X = fem.Function(self.W, name="mortar_X")
         self.w = fem.Function(self.W, name="mortar_w")
         self.m = fem.Function(self.M, name="mortar_mask")
         self._X = np.zeros((n_w, self.rows, 2))
         self._m = np.zeros((n_w, 2 + self.slots))
         self._src = np.zeros((n_w, self.rows), np.int64)
-        self._idx = np.zeros((n_w, 2), np.int64)
         Xs = self.striker.X
         Xj = Xs[self.me]
         for s, (nb, other) in enumerate(((left, right), (right, left))):
@@ -108,7 +110,6 @@ class MortarTransfer:
             self._X[:, s] = np.where(has[:, None], Xs[np.maximum(nb, 0)],
                                      2.0 * Xj - Xs[np.maximum(other, 0)])
             self._m[:, s] = has
-            self._idx[:, s] = np.where(has, nb, self.me)
             self._src[:, s] = self.striker.vertices[self._idx[:, s]]
         self.assignment = np.full((n_w, self.slots), -2, np.int64)
         self.version = 0
@@ -123,17 +124,7 @@ class MortarTransfer:
         self._searched_u = self.u.x.array.copy()
         us = self.striker.displacements(self.u)
         ut = self.target.displacements(self.u)
-        xs = self.striker.X + us
-        xt = (self.target.X + ut)[self.target.facet_vertex]
-        xj = xs[self.me]
-        x_side = [xs[self._idx[:, s]] for s in (0, 1)]
-        x_side = [np.where((self.sides[s] >= 0)[:, None], x_side[s], 2 * xj - x_side[1 - s])
-                  for s in (0, 1)]
-        scores = np.full((xj.shape[0], xt.shape[0]), -np.inf)
-        for s, (x1, x2) in enumerate(((x_side[0], xj), (xj, x_side[1]))):
-            sc = overlaps(x1, x2, xt[:, 0], xt[:, 1], self.reach)
-            sc[self.sides[s] < 0] = -np.inf
-            scores = np.maximum(scores, sc)
+        scores = self._scores(self.striker.X + us, self.target.X + ut)
         facet, used = pick_slots(scores, self.slots)
         self.search_count += 1
         w = np.zeros_like(self._X)
@@ -159,6 +150,23 @@ class MortarTransfer:
             self.version += 1
             return True
         return False
+
+    def _scores(self, xs: np.ndarray, xt: np.ndarray) -> np.ndarray:
+        """Overlap of each target facet with the node's two striker facets (see ``overlaps``).
+
+        ``xs``, ``xt``: current positions of the striker and target polyline vertices.
+        """
+        xt = xt[self.target.facet_vertex]
+        xj = xs[self.me]
+        x_side = [xs[self._idx[:, s]] for s in (0, 1)]
+        x_side = [np.where((self.sides[s] >= 0)[:, None], x_side[s], 2 * xj - x_side[1 - s])
+                  for s in (0, 1)]
+        scores = np.full((xj.shape[0], xt.shape[0]), -np.inf)
+        for s, (x1, x2) in enumerate(((x_side[0], xj), (xj, x_side[1]))):
+            sc = overlaps(x1, x2, xt[:, 0], xt[:, 1], self.reach)
+            sc[self.sides[s] < 0] = -np.inf
+            scores = np.maximum(scores, sc)
+        return scores
 
     def sources(self) -> list[np.ndarray]:
         """Global V block of each row of each owned node, shape (n_owned, rows)."""

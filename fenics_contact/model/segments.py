@@ -188,12 +188,6 @@ def facet_sizes(line: Polyline) -> np.ndarray:
     return np.linalg.norm(X[:, 1] - X[:, 0], axis=-1)
 
 
-def default_slots(striker: Polyline, target: Polyline) -> int:
-    """Slots enough for the two striker facets of a node over the finest target facets."""
-    ratio = 2.0 * float(np.max(facet_sizes(striker))) / float(np.min(facet_sizes(target)))
-    return int(max(3, np.ceil(ratio) + 1))
-
-
 def any_rank(comm: MPI.Comm, flag: bool) -> bool:
     """Whether ``flag`` holds on some rank (collective)."""
     return bool(comm.allreduce(bool(flag), op=MPI.LOR))

@@ -46,7 +46,9 @@ Deformable bodies in one mesh replace [material] and [contact] by::
 
     [[body]]     name, tag (cell tag), law, E, nu      (one per body)
     [[pair]]     name, striker, target (facet tags), r, relative,
-                 mu, tangential_r_max (Coulomb friction, as in [contact])
+                 mu, tangential_r_max (Coulomb friction, as in [contact]),
+                 discretisation = "node-to-segment" (default) | "mortar"
+                 (2D, frictionless; exact on non-matching meshes)
     [[obstacle]] as above, its tag on the facets of one body
 
 In every scene a [[dirichlet]] may give path = [[t, ux, uy], ...] (a
@@ -227,7 +229,7 @@ def _bodies(path: Path, data: dict[str, Any]) -> tuple[BodySpec, ...]:
     return tuple(out)
 
 
-def _pairs(path: Path, data: dict[str, Any]) -> tuple[PairSpec, ...]:
+def _pairs(path: Path, data: dict[str, Any], dimension: int = 2) -> tuple[PairSpec, ...]:
     out = []
     for reader in _array(path, data, "pair"):
         for key in ("striker", "target"):
@@ -242,8 +244,22 @@ def _pairs(path: Path, data: dict[str, Any]) -> tuple[PairSpec, ...]:
             r=_contact_r(reader), relative=reader.flag("relative", True),
             mu=_friction(reader),
             tangential_r_max=reader.number("tangential_r_max", 2.0, positive=True),
+            discretisation=_discretisation(reader, dimension),
         ))
     return tuple(out)
+
+
+def _discretisation(reader: _Reader, dim: int) -> str:
+    """[[pair]] discretisation: "node-to-segment" (default) or "mortar" (2D, frictionless)."""
+    value = reader.table.get("discretisation", "node-to-segment")
+    if value not in ("node-to-segment", "mortar"):
+        raise reader.fail("discretisation", 'choose "node-to-segment" (the default) or "mortar".')
+    if value == "mortar" and dim != 2:
+        raise reader.fail("discretisation", 'mortar is 2D only; use "node-to-segment" in 3D.')
+    if value == "mortar" and "mu" in reader.table:
+        raise reader.fail("discretisation", "mortar is frictionless; remove mu or use "
+                          '"node-to-segment".')
+    return value
 
 
 def _schedule(reader: _Reader, dimension: int) -> tuple[tuple[float, ...], ...]:
@@ -512,7 +528,7 @@ def _two_body_scene(path: Path, data: dict[str, Any], head: _Reader, dimension: 
             "each with the facet tag that may touch it (tag) and its r and mu."
         )
     bodies = _bodies(path, data)
-    pairs = _pairs(path, data)
+    pairs = _pairs(path, data, dimension)
     obstacles = _obstacle_blocks(path, data, dimension)
     if len(bodies) < 2:
         raise SceneError(f"{path.name}: {len(bodies)} [[body]] block(s); a contact pair needs "

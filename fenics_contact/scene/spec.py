@@ -80,6 +80,8 @@ class PairSpec:
     relative: bool = True
     mu: float | None = None
     tangential_r_max: float | None = 2.0
+    #: "node-to-segment" (one pass, the default) or "mortar" (2D, frictionless).
+    discretisation: str = "node-to-segment"
 
 
 @dataclass(frozen=True)
