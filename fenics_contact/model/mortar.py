@@ -87,9 +87,9 @@ class MortarTransfer:
             raise ValueError("A striker node of a mortar pair has no striker facet.")
         self.sides = (left, right)
         self._idx = np.stack([np.where(nb >= 0, nb, self.me) for nb in self.sides], axis=1)
-        if slots is None:  # what the reference configuration needs, and one more
+        if slots is None:  # what the reference configuration needs (at least 3)
             need = np.sum(self._scores(self.striker.X, self.target.X) > 0.0, axis=1)
-            slots = max(3, int(self.comm.allreduce(int(np.max(need, initial=0)), op=MPI.MAX)) + 1)
+            slots = max(3, int(self.comm.allreduce(int(np.max(need, initial=0)), op=MPI.MAX)))
         self.slots = int(slots)
         self.rows = 2 + 2 * self.slots
         self.W = fem.functionspace(sub, ("Lagrange", 1, (self.rows, 2)))

@@ -1,0 +1,236 @@
+"""Mortar (segment-to-segment) pairs in 2D: patch test, tangent, two cylinders, scenes.
+
+Every problem uses four slots so that one set of compiled forms serves the
+whole file (the first compilation of the mortar forms takes about a minute).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from dolfinx import fem
+from dolfinx.fem import petsc as fem_petsc
+
+from mpi4py import MPI
+
+from fenics_contact.model.body import Body, PrescribedDisplacement, Solid
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.model.materials import material
+from fenics_contact.model.mortar import MortarContact
+from fenics_contact.model.pairs import NodeToSegmentContact
+from fenics_contact.model.problem import ContactProblem
+from fenics_contact.scene import two_body_meshing as tbm
+from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.condensed import kernel_for
+from fenics_contact.solvers.diagnostics import SolverSettings
+from fenics_contact.verification.hertz import half_width, peak_pressure, pressure_profile
+
+SLOTS = 4
+ROOT = Path(__file__).resolve().parents[1]
+LAW = material("linear", 200.0, 0.3)
+#: Uniaxial plane strain, total height 1, pressed by 0.01.
+PATCH_PRESSURE = -200.0 / (1 - 0.3**2) * 0.01
+
+
+def _problem(md, fixed: dict, disc: str, r: float = 1.0) -> ContactProblem:
+    ft = md.facet_tags
+    bodies = [Body("upper", tbm.STRIKER_TAG, LAW), Body("lower", tbm.TARGET_TAG, LAW)]
+    prescribed = [PrescribedDisplacement(ft.find(t), v) for t, v in fixed.items()]
+    solid = Solid(md.mesh, bodies, md.cell_tags, prescribed=prescribed)
+    args = (ft.find(tbm.STRIKER_FACE_TAG), ft.find(tbm.TARGET_FACE_TAG), ContactSettings(r=r))
+    contact = (MortarContact(*args, slots=SLOTS) if disc == "mortar"
+               else NodeToSegmentContact(*args))
+    return ContactProblem(solid, [contact])
+
+
+BLOCKS = {tbm.LOAD_TAG: (None, -0.01), tbm.SUPPORT_TAG: (None, 0.0), tbm.SYMMETRY_TAG: (0.0, None)}
+
+
+def _blocks(n_upper: int, n_lower: int, disc: str, r: float = 1.0):
+    md = tbm.block_on_block(MPI.COMM_WORLD, n_upper=n_upper, n_lower=n_lower)
+    return _problem(md, BLOCKS, disc, r), md.facet_tags
+
+
+def _solve(problem, method: str, steps: int) -> tuple[list[int], list[list[float]]]:
+    strategy = make_strategy(method, problem, SolverSettings())
+    its, residuals = [], []
+    for i in range(1, steps + 1):
+        problem.set_load(i / steps)
+        result = strategy.solve()
+        assert result.converged, (method, i, result.status)
+        its.append(result.iterations)
+        residuals.append(list(result.residuals))
+    return its, residuals
+
+
+def _spread(problem, p: np.ndarray) -> float:
+    lo = problem.comm.allreduce(float(np.min(p, initial=np.inf)), op=MPI.MIN)
+    hi = problem.comm.allreduce(float(np.max(p, initial=-np.inf)), op=MPI.MAX)
+    return (hi - lo) / abs(PATCH_PRESSURE)
+
+
+# -- 1. patch test on non-matching meshes --------------------------------------------------
+@pytest.mark.mpi
+@pytest.mark.parametrize(("n_upper", "n_lower"), [(8, 11), (7, 5)])
+def test_mortar_patch_non_matching(n_upper: int, n_lower: int) -> None:
+    """Uniform nodal pressure to 1e-8 and force balance to 1e-10; NTS spreads on the same mesh."""
+    problem, ft = _blocks(n_upper, n_lower, "mortar")
+    _solve(problem, "gnrm", 2)
+    state = problem.contact_state()
+    np.testing.assert_allclose(state.pressure, PATCH_PRESSURE, rtol=1e-8)
+    top = problem.reaction(ft.find(tbm.LOAD_TAG))[1]
+    bottom = problem.reaction(ft.find(tbm.SUPPORT_TAG))[1]
+    assert abs(top + bottom) <= 1e-10 * state.contact_force
+    assert abs(-top - state.contact_force) <= 1e-10 * state.contact_force
+    assert state.max_penetration <= 1e-12
+    f = problem.target_force()
+    n = problem.V.dofmap.index_map.size_local
+    total = problem.comm.allreduce(f.x.array[: 2 * n].reshape(-1, 2).sum(axis=0), op=MPI.SUM)
+    assert abs(total[1] + state.contact_force) <= 1e-10 * state.contact_force
+    nts, _ = _blocks(n_upper, n_lower, "node-to-segment")
+    _solve(nts, "gnrm", 2)
+    assert _spread(nts, nts.contact_state().pressure) > 0.05
+
+
+@pytest.mark.parametrize(("method", "r"), [("penalty", 1.0), ("nua", 1.0), ("auto", 1.0),
+                                           ("sua", 0.1)])
+def test_mortar_strategies(method: str, r: float) -> None:
+    """Every strategy on the mortar patch test (SUA at r = 0.1 E/h as on NTS pairs)."""
+    problem, _ = _blocks(8, 11, "mortar", r)
+    if method == "sua":
+        strategy = make_strategy("sua", problem, SolverSettings(max_iterations=200))
+        for i in (1, 2):
+            problem.set_load(i / 2)
+            assert strategy.solve().converged
+    else:
+        _solve(problem, method, 2)
+    state = problem.contact_state()
+    if method == "penalty":  # uniform penetration p / r
+        assert 1e-4 < state.max_penetration < 1e-2
+        assert _spread(problem, state.pressure) < 1e-8
+    else:
+        np.testing.assert_allclose(state.pressure, PATCH_PRESSURE, rtol=1e-8)
+
+
+# -- 2. the tangent against finite differences ------------------------------------------------
+def _sheared(problem) -> None:
+    """Shift and bend the striker so its nodes straddle target vertices; random lam < 0."""
+    V, u = problem.V, problem.u
+    md_tags = problem.solid.cell_tags
+    tdim = problem.domain.topology.dim
+    dofs = fem.locate_dofs_topological(V, tdim, md_tags.find(tbm.STRIKER_TAG))
+    x = V.tabulate_dof_coordinates()
+    values = u.x.array.reshape(-1, 2)
+    for d in dofs:
+        X = x[d]
+        values[d] = (0.031 + 0.02 * X[1] + 0.01 * X[0] ** 2,
+                     -0.003 + 0.004 * np.sin(3.0 * X[0]) - 0.002 * (X[1] - 0.5))
+    u.x.scatter_forward()
+    rng = np.random.default_rng(3)
+    lam = problem.contact.lam
+    lam.x.array[:] = -rng.uniform(0.5, 3.0, lam.x.array.size)
+    lam.x.scatter_forward()
+
+
+def test_mortar_tangent_finite_differences() -> None:
+    """J du against central differences of the condensed residual (segments, sliding offsets)."""
+    problem, _ = _blocks(5, 7, "mortar", r=1.0)
+    _sheared(problem)
+    kernel = kernel_for(problem.augmented_system())
+    kernel._pull()
+    x0 = kernel.x.copy()
+    rng = np.random.default_rng(7)
+    du = x0.duplicate()
+    arr = rng.standard_normal(x0.getLocalSize())
+    arr[kernel._bc_local] = 0.0
+    du.setArray(arr)
+
+    def residual(x) -> np.ndarray:
+        fem_petsc.assign(x, kernel.unknowns)
+        for f in kernel.unknowns:
+            f.x.scatter_forward()
+        kernel._assemble_b()
+        return kernel.b.getArray().copy()
+
+    residual(x0)
+    kernel._assemble_A()
+    jdu = x0.duplicate()
+    kernel.A.mult(du, jdu)
+    gaps = problem.contact_state().gap
+    assert np.sum(gaps < 0) >= 2 and np.sum(gaps > 0) >= 1  # both sides of the kink
+    errors = []
+    for eps in (1e-5, 1e-6):
+        plus = x0.copy()
+        plus.axpy(eps, du)
+        minus = x0.copy()
+        minus.axpy(-eps, du)
+        fd = (residual(plus) - residual(minus)) / (2 * eps)
+        ref = jdu.getArray()
+        errors.append(np.linalg.norm(fd - ref) / np.linalg.norm(fd))
+    print("tangent relative errors", errors)
+    assert min(errors) < 1e-6, errors
+
+
+# -- 3. and 4. two cylinders --------------------------------------------------------------
+def _cylinders(disc: str, r: float, h: float = 0.02) -> dict:
+    md = tbm.two_half_disks(MPI.COMM_WORLD, h_contact=h, h_far=0.2)
+    problem = _problem(md, {tbm.LOAD_TAG: (0.0, -0.02), tbm.SUPPORT_TAG: (0.0, 0.0)}, disc, r)
+    its, residuals = _solve(problem, "gnrm", 3)
+    state = problem.contact_state()
+    x = np.concatenate(problem.comm.allgather(problem.nodal_coordinates()[:, 0]))
+    p = -np.concatenate(problem.comm.allgather(state.pressure))
+    P = state.contact_force
+    a, p0 = half_width(P, 0.5, 100.0, 0.3), peak_pressure(P, 0.5, 100.0, 0.3)
+    hertz = pressure_profile(x, p0, a)
+    near = np.abs(x) < 1.5 * a
+    l2 = float(np.sqrt(np.sum((p - hertz)[near] ** 2) / np.sum(hertz[near] ** 2)))
+    return {"its": its, "residuals": residuals, "force": P, "x": x, "p": p,
+            "peak": float(p.max() / p0 - 1), "l2": l2, "state": state}
+
+
+@pytest.fixture(scope="module")
+def cylinders() -> dict:
+    return {r: _cylinders("mortar", r) for r in (1e-2, 1.0, 1e2)}
+
+
+def test_mortar_two_cylinders_hertz(cylinders: dict) -> None:
+    """Peak and L2 error of the nodal pressure against Hertz (h = 0.02, a/h ~ 4); NTS for scale."""
+    mortar = cylinders[1.0]
+    assert mortar["state"].max_penetration < 1e-10
+    assert abs(mortar["peak"]) < 0.01, mortar["peak"]
+    assert mortar["l2"] < 0.02, mortar["l2"]
+
+
+def test_mortar_two_cylinders_quadratic_and_r_independent(cylinders: dict) -> None:
+    """Order >= 1.8 over the last Newton iterations; the same answer for r = 1e-2 ... 1e2 E/h."""
+    for residuals in cylinders[1.0]["residuals"]:
+        r = [v for v in residuals if v > 1e-11]
+        if len(r) >= 3:
+            a, b, c = r[-3:]
+            assert np.log(c / b) / np.log(b / a) >= 1.8, residuals
+    ref = cylinders[1.0]
+    for r in (1e-2, 1e2):
+        assert abs(cylinders[r]["force"] - ref["force"]) <= 1e-8 * ref["force"]
+        np.testing.assert_allclose(cylinders[r]["p"], ref["p"], atol=1e-8 * ref["p"].max())
+
+
+# -- scenes -------------------------------------------------------------------------------------
+def _scene_text(edit) -> str:
+    text = (ROOT / "scenes" / "block_on_block.toml").read_text()
+    return edit(text).replace("../meshes", str(ROOT / "meshes"))
+
+
+def test_mortar_scene_key_errors(tmp_path) -> None:
+    from fenics_contact.scene.schema import SceneError, load_scene
+
+    for value, message in (('"segment"', "discretisation = 'segment'"),
+                           ('"mortar"\nmu = 0.2', "mortar is frictionless")):
+        path = tmp_path / "bad.toml"
+        path.write_text(_scene_text(lambda s, v=value: s.replace(
+            'target = "target_face"', f'target = "target_face"\ndiscretisation = {v}')))
+        with pytest.raises(SceneError, match="discretisation") as err:
+            load_scene(path)
+        assert message in str(err.value)
+        assert "node-to-segment" in str(err.value)
