@@ -30,16 +30,17 @@ from __future__ import annotations
 
 import numpy as np
 import ufl
-from dolfinx import fem, la
+from dolfinx import default_scalar_type, fem, la
 
 from mpi4py import MPI
 
 from fenics_contact.model.contact import ContactSettings, ContactSurface
 from fenics_contact.model.contacts import Contact
 from fenics_contact.model.segments import (
+    NEAR,
+    REACH,
     Polyline,
     any_rank,
-    facet_sizes,
     neighbours,
     node_blocks,
     overlaps,
@@ -70,8 +71,6 @@ class MortarTransfer:
         self.V, self.u, self.comm = V, u, V.mesh.comm
         self.striker = Polyline(V, surface.facets)
         self.target = Polyline(V, target_facets)
-        self.reach = 2.0 * max(float(np.max(facet_sizes(self.striker))),
-                               float(np.max(facet_sizes(self.target))))
         sub = surface.submesh
         Q = surface.Q
         parent = np.asarray(surface.node_map)[sub.geometry.dofmaps[0].reshape(-1)]
@@ -87,9 +86,10 @@ class MortarTransfer:
             raise ValueError("A striker node of a mortar pair has no striker facet.")
         self.sides = (left, right)
         self._idx = np.stack([np.where(nb >= 0, nb, self.me) for nb in self.sides], axis=1)
-        if slots is None:  # what the reference configuration needs (at least 3)
-            need = np.sum(self._scores(self.striker.X, self.target.X) > 0.0, axis=1)
-            slots = max(3, int(self.comm.allreduce(int(np.max(need, initial=0)), op=MPI.MAX)))
+        if slots is None:  # what the reference configuration needs (at least 4)
+            scores, near = self._scores(self.striker.X, self.target.X)
+            need = np.where(near, np.sum(scores > 0.0, axis=1), 0)
+            slots = max(4, int(self.comm.allreduce(int(np.max(need, initial=0)), op=MPI.MAX)))
         self.slots = int(slots)
         self.rows = 2 + 2 * self.slots
         self.W = fem.functionspace(sub, ("Lagrange", 1, (self.rows, 2)))
@@ -124,8 +124,8 @@ class MortarTransfer:
         self._searched_u = self.u.x.array.copy()
         us = self.striker.displacements(self.u)
         ut = self.target.displacements(self.u)
-        scores = self._scores(self.striker.X + us, self.target.X + ut)
-        facet, used = pick_slots(scores, self.slots)
+        scores, near = self._scores(self.striker.X + us, self.target.X + ut)
+        facet, used = pick_slots(scores, near, self.slots)
         self.search_count += 1
         w = np.zeros_like(self._X)
         w[:, 0], w[:, 1] = us[self._idx[:, 0]], us[self._idx[:, 1]]
@@ -152,7 +152,7 @@ class MortarTransfer:
         return False
 
     def _scores(self, xs: np.ndarray, xt: np.ndarray) -> np.ndarray:
-        """Overlap of each target facet with the node's two striker facets (see ``overlaps``).
+        """Overlaps of the target facets with each node's two striker facets, and near contact.
 
         ``xs``, ``xt``: current positions of the striker and target polyline vertices.
         """
@@ -162,11 +162,13 @@ class MortarTransfer:
         x_side = [np.where((self.sides[s] >= 0)[:, None], x_side[s], 2 * xj - x_side[1 - s])
                   for s in (0, 1)]
         scores = np.full((xj.shape[0], xt.shape[0]), -np.inf)
+        near = np.zeros(xj.shape[0], bool)
         for s, (x1, x2) in enumerate(((x_side[0], xj), (xj, x_side[1]))):
-            sc = overlaps(x1, x2, xt[:, 0], xt[:, 1], self.reach)
+            sc, dist = overlaps(x1, x2, xt[:, 0], xt[:, 1], REACH)
             sc[self.sides[s] < 0] = -np.inf
+            near |= np.any((sc > 0.0) & (dist < NEAR), axis=1)
             scores = np.maximum(scores, sc)
-        return scores
+        return scores, near
 
     def sources(self) -> list[np.ndarray]:
         """Global V block of each row of each owned node, shape (n_owned, rows)."""
@@ -177,7 +179,7 @@ class MortarTransfer:
         return ufl.as_vector((f[i, 0], f[i, 1]))
 
     def nodal_gap(self, X_j: ufl.core.expr.Expr, x_j: ufl.core.expr.Expr,
-                  g_open: float) -> ufl.core.expr.Expr:
+                  g_open: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
         """G_j = g~_j / A~_j at a striker node (reference ``X_j``, current ``x_j``; length)."""
         X_nb = [self._point(self.X, s) for s in (0, 1)]
         x_nb = [X_nb[s] + self._point(self.w, s) for s in (0, 1)]
@@ -261,7 +263,10 @@ class MortarContact(Contact):
                                      self._slots)
         X = ufl.SpatialCoordinate(solid.domain)
         self.mortar.refresh()
-        return self.mortar.nodal_gap(X, X + solid.u, float(self.surface.h))
+        #: The gap of a node whose support meets no target facet (length; a Constant so
+        #: that the compiled forms do not depend on the mesh).
+        self.open_gap = fem.Constant(solid.domain, default_scalar_type(self.surface.h))
+        return self.mortar.nodal_gap(X, X + solid.u, self.open_gap)
 
     def refresh(self) -> bool:
         """Search the slots and refill the coefficients when u has changed."""

@@ -26,6 +26,10 @@ from dolfinx import fem, mesh
 
 from mpi4py import MPI
 
+#: Target facets farther than this many striker facet lengths are not candidates.
+REACH = 2.0
+#: A node whose target lies within this many facet lengths counts as near contact.
+NEAR = 0.25
 #: Lowest cosine of the angle between the striker normal and minus the target normal.
 OPPOSING = 0.2
 #: A target facet whose projection misses a striker facet by up to this (local coordinate)
@@ -125,7 +129,7 @@ def neighbours(line: Polyline, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarra
 
 
 def overlaps(x1: np.ndarray, x2: np.ndarray, ta: np.ndarray, tb: np.ndarray,
-             reach: float) -> np.ndarray:
+             reach: float) -> tuple[np.ndarray, np.ndarray]:
     """Overlap (local coordinate of the striker facet) of every target facet with each facet.
 
     Args:
@@ -135,9 +139,11 @@ def overlaps(x1: np.ndarray, x2: np.ndarray, ta: np.ndarray, tb: np.ndarray,
         tb: (m, 2) their second end points.
         reach: largest |normal distance| of a target facet that counts (length).
 
-    Returns (n, m): the length in [0, 1] local coordinates of the projection
-    overlap, -inf where the facets do not face each other or are out of reach,
-    and slightly negative values (down to -MARGIN) for near misses.
+    Returns (n, m) arrays: the length in [0, 1] local coordinates of the
+    projection overlap (-inf where the facets do not face each other or lie
+    farther than ``reach`` times the striker facet's length; slightly
+    negative values, down to -MARGIN, for near misses), and the normal
+    distance relative to the striker facet's length.
     """
     t = x2 - x1
     tt = np.einsum("ij,ij->i", t, t)
@@ -151,25 +157,29 @@ def overlaps(x1: np.ndarray, x2: np.ndarray, ta: np.ndarray, tb: np.ndarray,
     nt /= np.linalg.norm(nt, axis=-1, keepdims=True)
     cos = -ns @ nt.T
     mid = x1[:, None] + (0.5 * (lo + hi))[..., None] * t[:, None]
-    dist = np.abs(np.einsum("nmi,mi->nm", ta[None] - mid, nt))
+    dist = np.abs(np.einsum("nmi,mi->nm", ta[None] - mid, nt)) / np.sqrt(tt)[:, None]
     out = hi - lo
     out[(cos < OPPOSING) | (dist > reach) | (out < -MARGIN)] = -np.inf
-    return out
+    return out, dist
 
 
-def pick_slots(scores: np.ndarray, slots: int) -> tuple[np.ndarray, np.ndarray]:
+def pick_slots(scores: np.ndarray, near: np.ndarray,
+               slots: int) -> tuple[np.ndarray, np.ndarray]:
     """The ``slots`` best target facets per row of ``scores`` (-1 where none).
 
-    Raises ValueError when more than ``slots`` facets overlap with positive length.
+    A node whose facets overlap more target facets than there are slots
+    keeps the largest overlaps; that is an error (ValueError) only where the
+    node is near contact (``near``), elsewhere its gap is only used to see
+    that it is open.
     """
     n = scores.shape[0]
     if n == 0 or scores.shape[1] == 0:
         return np.full((n, slots), -1, np.int64), np.zeros((n, slots), bool)
-    need = int(np.max(np.sum(scores > 0.0, axis=1), initial=0))
-    if need > slots:
+    count = np.sum(scores > 0.0, axis=1)
+    if np.any((count > slots) & near):
         raise ValueError(
-            f"A striker node's facets overlap {need} target facets, more than the {slots} "
-            "mortar slots; raise the pair's slots (finer target than striker)."
+            f"A striker node near contact overlaps {int(np.max(count[near]))} target facets, "
+            f"more than the {slots} mortar slots; give the pair more slots."
         )
     k = min(slots, scores.shape[1])
     order = np.argsort(-scores, axis=1, kind="stable")[:, :k]
