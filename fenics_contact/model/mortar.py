@@ -39,8 +39,10 @@ from fenics_contact.model.contacts import Contact
 from fenics_contact.model.segments import (
     NEAR,
     REACH,
+    SLOTS,
     Polyline,
     any_rank,
+    facet_sizes,
     neighbours,
     node_blocks,
     overlaps,
@@ -86,11 +88,9 @@ class MortarTransfer:
             raise ValueError("A striker node of a mortar pair has no striker facet.")
         self.sides = (left, right)
         self._idx = np.stack([np.where(nb >= 0, nb, self.me) for nb in self.sides], axis=1)
-        if slots is None:  # what the reference configuration needs (at least 4)
-            scores, near = self._scores(self.striker.X, self.target.X)
-            need = np.where(near, np.sum(scores > 0.0, axis=1), 0)
-            slots = max(4, int(self.comm.allreduce(int(np.max(need, initial=0)), op=MPI.MAX)))
-        self.slots = int(slots)
+        self.slots = int(SLOTS if slots is None else slots)
+        self.reach = REACH * max(float(np.max(facet_sizes(self.striker))),
+                                 float(np.max(facet_sizes(self.target))))
         self.rows = 2 + 2 * self.slots
         self.W = fem.functionspace(sub, ("Lagrange", 1, (self.rows, 2)))
         self.M = fem.functionspace(sub, ("Lagrange", 1, (2 + self.slots,)))
@@ -125,7 +125,10 @@ class MortarTransfer:
         us = self.striker.displacements(self.u)
         ut = self.target.displacements(self.u)
         scores, near = self._scores(self.striker.X + us, self.target.X + ut)
-        facet, used = pick_slots(scores, near, self.slots)
+        facet, used, dropped = pick_slots(scores, self.slots)
+        #: Striker nodes near contact (target within NEAR facet lengths) that overlap more
+        #: target facets than there are slots (owned, this rank); 0 in every test.
+        self.overflow = int(np.sum(((dropped > 0) & near)[: self.n_owned]))
         self.search_count += 1
         w = np.zeros_like(self._X)
         w[:, 0], w[:, 1] = us[self._idx[:, 0]], us[self._idx[:, 1]]
@@ -164,7 +167,7 @@ class MortarTransfer:
         scores = np.full((xj.shape[0], xt.shape[0]), -np.inf)
         near = np.zeros(xj.shape[0], bool)
         for s, (x1, x2) in enumerate(((x_side[0], xj), (xj, x_side[1]))):
-            sc, dist = overlaps(x1, x2, xt[:, 0], xt[:, 1], REACH)
+            sc, dist = overlaps(x1, x2, xt[:, 0], xt[:, 1], self.reach)
             sc[self.sides[s] < 0] = -np.inf
             near |= np.any((sc > 0.0) & (dist < NEAR), axis=1)
             scores = np.maximum(scores, sc)

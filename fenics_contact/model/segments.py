@@ -26,10 +26,12 @@ from dolfinx import fem, mesh
 
 from mpi4py import MPI
 
-#: Target facets farther than this many striker facet lengths are not candidates.
+#: Target facets farther than this many of the largest facet lengths are not candidates.
 REACH = 2.0
 #: A node whose target lies within this many facet lengths counts as near contact.
 NEAR = 0.25
+#: Slots per striker node unless the pair says otherwise.
+SLOTS = 4
 #: Lowest cosine of the angle between the striker normal and minus the target normal.
 OPPOSING = 0.2
 #: A target facet whose projection misses a striker facet by up to this (local coordinate)
@@ -141,7 +143,7 @@ def overlaps(x1: np.ndarray, x2: np.ndarray, ta: np.ndarray, tb: np.ndarray,
 
     Returns (n, m) arrays: the length in [0, 1] local coordinates of the
     projection overlap (-inf where the facets do not face each other or lie
-    farther than ``reach`` times the striker facet's length; slightly
+    farther than ``reach``; slightly
     negative values, down to -MARGIN, for near misses), and the normal
     distance relative to the striker facet's length.
     """
@@ -157,30 +159,24 @@ def overlaps(x1: np.ndarray, x2: np.ndarray, ta: np.ndarray, tb: np.ndarray,
     nt /= np.linalg.norm(nt, axis=-1, keepdims=True)
     cos = -ns @ nt.T
     mid = x1[:, None] + (0.5 * (lo + hi))[..., None] * t[:, None]
-    dist = np.abs(np.einsum("nmi,mi->nm", ta[None] - mid, nt)) / np.sqrt(tt)[:, None]
+    dist = np.abs(np.einsum("nmi,mi->nm", ta[None] - mid, nt))
     out = hi - lo
     out[(cos < OPPOSING) | (dist > reach) | (out < -MARGIN)] = -np.inf
-    return out, dist
+    return out, dist / np.sqrt(tt)[:, None]
 
 
-def pick_slots(scores: np.ndarray, near: np.ndarray,
-               slots: int) -> tuple[np.ndarray, np.ndarray]:
-    """The ``slots`` best target facets per row of ``scores`` (-1 where none).
+def pick_slots(scores: np.ndarray, slots: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The ``slots`` largest overlaps per row of ``scores`` (-1 where none).
 
-    A node whose facets overlap more target facets than there are slots
-    keeps the largest overlaps; that is an error (ValueError) only where the
-    node is near contact (``near``), elsewhere its gap is only used to see
-    that it is open.
+    Returns the facets, whether each slot is used, and per row the number
+    of target facets with a positive overlap that found no slot: such a
+    node's gap is averaged over the part of its support its slots cover.
     """
     n = scores.shape[0]
     if n == 0 or scores.shape[1] == 0:
-        return np.full((n, slots), -1, np.int64), np.zeros((n, slots), bool)
-    count = np.sum(scores > 0.0, axis=1)
-    if np.any((count > slots) & near):
-        raise ValueError(
-            f"A striker node near contact overlaps {int(np.max(count[near]))} target facets, "
-            f"more than the {slots} mortar slots; give the pair more slots."
-        )
+        return (np.full((n, slots), -1, np.int64), np.zeros((n, slots), bool),
+                np.zeros(n, np.int64))
+    dropped = np.maximum(np.sum(scores > 0.0, axis=1) - slots, 0)
     k = min(slots, scores.shape[1])
     order = np.argsort(-scores, axis=1, kind="stable")[:, :k]
     best = np.take_along_axis(scores, order, axis=1)
@@ -189,7 +185,7 @@ def pick_slots(scores: np.ndarray, near: np.ndarray,
     ok = np.isfinite(best)
     facet[:, :k] = np.where(ok, order, -1)
     used[:, :k] = ok
-    return facet, used
+    return facet, used, dropped
 
 
 def facet_sizes(line: Polyline) -> np.ndarray:
