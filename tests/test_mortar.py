@@ -258,7 +258,9 @@ def test_mortar_scene_runs_end_to_end(tmp_path) -> None:
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == "converged"
     assert summary["steps_completed"] == summary["load_steps"] == 2
-    assert (out / "solution.xdmf").is_file() and (out / "solution.h5").stat().st_size > 0
+    assert (out / "solution.xdmf").is_file()
+    assert (out / "solution" / "step_0002.h5").stat().st_size > 0
+    assert abs(summary["steps"][-1]["contact_force"] + PATCH_PRESSURE) < 1e-10
     from fenics_contact.scene.schema import load_scene
 
     assert load_scene(ROOT / "scenes" / "two_cylinders_mortar.toml").pairs[0].discretisation \
