@@ -63,3 +63,16 @@ def test_mortar_two_cylinders_quadratic_and_r_independent(cylinders: dict) -> No
     for r in (1e-2, 1e2):
         assert abs(cylinders[r]["force"] - ref["force"]) <= 1e-8 * ref["force"]
         np.testing.assert_allclose(cylinders[r]["p"], ref["p"], atol=1e-8 * ref["p"].max())
+
+
+#: Measured in serial (h = 0.01, 6 steps, r = 1 E/h, four slots).
+EXPECTED_ITS = [6, 4, 3, 3, 3, 4]
+EXPECTED_FORCE = 1.0741917390996716
+
+
+@pytest.mark.mpi
+def test_mortar_two_cylinders_serial_counts() -> None:
+    """The serial Newton counts and force; `mpiexec -n 2` must give the same."""
+    result = _cylinders("mortar", 1.0)
+    assert result["its"] == EXPECTED_ITS
+    assert abs(result["force"] - EXPECTED_FORCE) <= 1e-10 * EXPECTED_FORCE
