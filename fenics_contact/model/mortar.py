@@ -114,6 +114,7 @@ class MortarTransfer:
         self.assignment = np.full((n_w, self.slots), -2, np.int64)
         self.version = 0
         self.search_count = 0
+        self.overflow = 0
         self._searched_u: np.ndarray | None = None
 
     def refresh(self) -> bool:
