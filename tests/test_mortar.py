@@ -213,3 +213,23 @@ def test_mortar_scene_runs_end_to_end(tmp_path) -> None:
 
     assert load_scene(ROOT / "scenes" / "two_cylinders_mortar.toml").pairs[0].discretisation \
         == "mortar"
+
+
+def test_mortar_weighted_gap_of_a_tilted_target() -> None:
+    """G_j is the hat-weighted mean of the gap: k x_j inside, k (x_j -+ h/3) at the ends.
+
+    The target's top is tilted to y = H - k x (u_y = -k x on the lower block);
+    the striker is untouched, so its normal is (0, -1) and g(x) = k x.
+    """
+    problem, _ = _blocks(5, 7, "mortar")
+    V, u = problem.V, problem.u
+    tdim = problem.domain.topology.dim
+    dofs = fem.locate_dofs_topological(V, tdim, problem.solid.cell_tags.find(tbm.TARGET_TAG))
+    k = 0.01
+    u.x.array.reshape(-1, 2)[dofs, 1] = -k * V.tabulate_dof_coordinates()[dofs, 0]
+    u.x.scatter_forward()
+    state = problem.contact_state()
+    x = problem.nodal_coordinates()[:, 0]
+    h = 1.0 / 5
+    expected = k * np.where(x < 1e-12, h / 3, np.where(x > 1 - 1e-12, 1 - h / 3, x))
+    np.testing.assert_allclose(state.gap, expected, rtol=1e-12, atol=1e-15)
