@@ -21,6 +21,7 @@ from mpi4py import MPI
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.friction import FrictionSettings
 from fenics_contact.model.materials import material
+from fenics_contact.model.mortar import MortarContact
 from fenics_contact.model.obstacle_contact import ObstacleContact
 from fenics_contact.model.obstacles import RigidBall, RigidObstacle, RigidPlane
 from fenics_contact.model.pairs import NodeToSegmentContact
@@ -345,6 +346,10 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
         check_pair_surfaces(scene, body.domain, body.cell_tags, bodies, striker, target, pair)
         friction = (None if pair.mu is None
                     else FrictionSettings(pair.mu, pair.tangential_r_max))
+        if pair.discretisation == "mortar":
+            contacts.append(MortarContact(striker, target, ContactSettings(
+                r=pair.r, relative=pair.relative), name=pair.name))
+            continue
         contacts.append(NodeToSegmentContact(
             striker, target, ContactSettings(r=pair.r, relative=pair.relative),
             friction=friction, name=pair.name, self_contact=pair.self_contact,

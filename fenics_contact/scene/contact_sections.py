@@ -151,7 +151,7 @@ def _contact(reader: _Reader, dimension: int) -> ContactSpec:
     )
 
 
-def read_pairs(path: Path, data: dict[str, Any]) -> tuple[PairSpec, ...]:
+def read_pairs(path: Path, data: dict[str, Any], dimension: int = 2) -> tuple[PairSpec, ...]:
     """The [[pair]] blocks: striker and target facet tags, r and friction per pair."""
     out = []
     for reader in _array(path, data, "pair"):
@@ -175,8 +175,25 @@ def read_pairs(path: Path, data: dict[str, Any]) -> tuple[PairSpec, ...]:
             tangential_r_max=reader.number("tangential_r_max", 2.0, positive=True),
             self_contact=self_contact,
             neighbourhood=reader.number("neighbourhood", 3.0, positive=True),
+            discretisation=_discretisation(reader, dimension),
         ))
     return tuple(out)
+
+
+def _discretisation(reader: _Reader, dim: int) -> str:
+    """[[pair]] discretisation: "node-to-segment" (default) or "mortar" (2D, frictionless)."""
+    value = reader.table.get("discretisation", "node-to-segment")
+    if value not in ("node-to-segment", "mortar"):
+        raise reader.fail("discretisation", 'choose "node-to-segment" (the default) or "mortar".')
+    if value == "mortar" and dim != 2:
+        raise reader.fail("discretisation", 'mortar is 2D only; use "node-to-segment" in 3D.')
+    if value == "mortar" and "mu" in reader.table:
+        raise reader.fail("discretisation", "mortar is frictionless; remove mu or use "
+                          '"node-to-segment".')
+    if value == "mortar" and reader.flag("self_contact", False):
+        raise reader.fail("discretisation", "mortar pairs two bodies; a self-contact pair is "
+                          '"node-to-segment".')
+    return value
 
 
 def _contact_r(reader: _Reader) -> float:

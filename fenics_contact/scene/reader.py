@@ -14,7 +14,7 @@ KEYS: dict[str, set[str]] = {
          "output", "body", "pair"},
     "body": {"name", "tag", "law", "E", "nu"},
     "pair": {"name", "striker", "target", "r", "relative", "mu", "tangential_r_max",
-             "self_contact", "neighbourhood"},
+             "self_contact", "neighbourhood", "discretisation"},
     "scene": {"name", "dimension", "description"},
     "mesh": {"file", "generator", "origin", "size", "cells", "cell", "parameters"},
     "material": {"law", "E", "nu", "kinematics"},

@@ -51,6 +51,8 @@ Deformable bodies in one mesh replace [material] and [contact] by::
                  self_contact = true (the target on the striker's own body; target
                  defaults to striker; one [[body]] is then enough), neighbourhood
                  (facet sizes along the surface a node does not search; default 3)
+                 discretisation = "node-to-segment" (default) | "mortar"
+                 (2D, frictionless; exact on non-matching meshes)
     [[obstacle]] as above, its tag on the facets of one body
 
 In every scene a [[dirichlet]] may give path = [[t, ux, uy], ...] (a
@@ -214,7 +216,7 @@ def _two_body_scene(path: Path, data: dict[str, Any], head: _Reader, dimension: 
             "each with the facet tag that may touch it (tag) and its r and mu."
         )
     bodies = read_bodies(path, data)
-    pairs = read_pairs(path, data)
+    pairs = read_pairs(path, data, dimension)
     obstacles = read_obstacle_blocks(path, data, dimension)
     if len(bodies) < 2 and not any(p.self_contact for p in pairs):
         raise SceneError(f"{path.name}: {len(bodies)} [[body]] block(s); a contact pair needs "

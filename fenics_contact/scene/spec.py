@@ -84,6 +84,8 @@ class PairSpec:
     self_contact: bool = False
     #: Radius of each node's excluded neighbourhood along the surface (facet sizes).
     neighbourhood: float = 3.0
+    #: "node-to-segment" (one pass, the default) or "mortar" (2D, frictionless).
+    discretisation: str = "node-to-segment"
 
 
 @dataclass(frozen=True)

@@ -116,7 +116,8 @@ class CondensedKernel(NewtonKernel):
         rank = self._comm.rank
         cols = [self._red0[rank] + np.arange(self._n_red, dtype=np.int64)]
         for src in self.transfer.sources():
-            base = self._reduced_rows(np.asarray(src, np.int64))
+            base = self._reduced_rows(np.asarray(src, np.int64).reshape(-1))
+            # a 2D source (node, row) selects for a packed coefficient of shape (rows, bs)
             cols.append((base[:, None] + np.arange(self._bs)[None, :]).reshape(-1))
         col = np.concatenate(cols).astype(PETSc.IntType)
         assert col.size == self._n_ext

@@ -1,0 +1,318 @@
+"""Mortar (segment-to-segment) frictionless contact of two bodies in 2D, in UFL.
+
+Multiplier lam P1 on the striker's contact submesh (lam <= 0 the pressure).
+Weighted gap of striker node j, projected along the striker facet's normal
+n_s (outward, piecewise constant):
+
+    g~_j = int_{Gamma_s} N_j(X) g(X) dA,   g = (x_t - x_s) . n_s   (g >= 0 open)
+
+with x_t the point of the target facet hit by the ray x_s + alpha n_s, so
+g = alpha = (x_a - x_s) . n_t / (n_s . n_t) for a target facet (a, b) of
+any normal n_t. On a segment g is linear in the striker facet's local
+coordinate; N_j g is quadratic and the two-point Gauss rule on each segment
+is exact. dA is the reference length of the striker facet. The nodal gap is
+G_j = g~_j / A~_j, A~_j = int_{segments} N_j dA (the part of the support the
+target covers; A~_j = A_j = int N_j dA where the target covers the
+support), and Alart-Curnier holds on the pairs (lam_j, G_j) with the vertex
+rule, so the converged answer does not depend on r. A node whose support
+meets no target facet is open (G_j = h).
+
+The segment end points are the projections of the target facet ends onto
+the striker facet (clamped to it), min/max expressions of the current
+positions; every position is a UFL coefficient (the striker's own u, the
+neighbours' and the slot targets' displacements w_k selected from u by
+:class:`MortarTransfer`), so ``ufl.derivative`` gives the full tangent:
+normals, projections and segment ends. Only the choice of the slots (which
+target facets a node sees) is frozen between searches.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import ufl
+from dolfinx import default_scalar_type, fem, la
+
+from mpi4py import MPI
+
+from fenics_contact.model.contact import ContactSettings, ContactSurface
+from fenics_contact.model.contacts import Contact
+from fenics_contact.model.segments import (
+    NEAR,
+    REACH,
+    SLOTS,
+    Polyline,
+    any_rank,
+    facet_sizes,
+    neighbours,
+    node_blocks,
+    overlaps,
+    pick_slots,
+)
+
+_GAUSS = ((0.5 - 0.5 / np.sqrt(3.0), 0.5), (0.5 + 0.5 / np.sqrt(3.0), 0.5))
+
+
+def _perp(t: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+    return ufl.as_vector((t[1], -t[0]))
+
+
+class MortarTransfer:
+    """Striker neighbours and target slots of every striker node; the selection w = S u.
+
+    Coefficients on the striker submesh, one row per point of a node's
+    stencil (row 0: the left neighbour, 1: the right one, 2 + 2k and
+    3 + 2k: the ends a_k, b_k of slot k's target facet): reference positions
+    ``X`` and displacements ``w`` (P1, shape (rows, 2)), and masks ``m``
+    (P1, shape (2 + slots,): 1 where the neighbour or the slot exists).
+    Unused slots point at the node itself with mask 0. One packed
+    coefficient keeps the Jacobian at 3 x 3 blocks.
+    """
+
+    def __init__(self, V: fem.FunctionSpace, u: fem.Function, surface: ContactSurface,
+                 target_facets: np.ndarray, slots: int | None = None) -> None:
+        self.V, self.u, self.comm = V, u, V.mesh.comm
+        self.striker = Polyline(V, surface.facets)
+        self.target = Polyline(V, target_facets)
+        sub = surface.submesh
+        Q = surface.Q
+        parent = np.asarray(surface.node_map)[sub.geometry.dofmaps[0].reshape(-1)]
+        n_w = Q.dofmap.index_map.size_local + Q.dofmap.index_map.num_ghosts
+        node = np.zeros(n_w, np.int64)
+        node[Q.dofmap.list.reshape(-1)] = parent
+        local = node_blocks(V)[node].astype(np.int32)
+        self.block = V.dofmap.index_map.local_to_global(local).astype(np.int64)
+        self.n_owned = Q.dofmap.index_map.size_local
+        self.me = self.striker.index(self.block)
+        left, right = neighbours(self.striker, self.me)
+        if np.any((left < 0) & (right < 0)):
+            raise ValueError("A striker node of a mortar pair has no striker facet.")
+        self.sides = (left, right)
+        self._idx = np.stack([np.where(nb >= 0, nb, self.me) for nb in self.sides], axis=1)
+        self.slots = int(SLOTS if slots is None else slots)
+        self.reach = REACH * max(float(np.max(facet_sizes(self.striker))),
+                                 float(np.max(facet_sizes(self.target))))
+        self.rows = 2 + 2 * self.slots
+        self.W = fem.functionspace(sub, ("Lagrange", 1, (self.rows, 2)))
+        self.M = fem.functionspace(sub, ("Lagrange", 1, (2 + self.slots,)))
+        if not (np.array_equal(self.W.dofmap.list, Q.dofmap.list)
+                and np.array_equal(self.M.dofmap.list, Q.dofmap.list)):
+            raise RuntimeError("The blocked and scalar P1 submesh spaces number nodes differently.")
+        self.X = fem.Function(self.W, name="mortar_X")
+        self.w = fem.Function(self.W, name="mortar_w")
+        self.m = fem.Function(self.M, name="mortar_mask")
+        self._X = np.zeros((n_w, self.rows, 2))
+        self._m = np.zeros((n_w, 2 + self.slots))
+        self._src = np.zeros((n_w, self.rows), np.int64)
+        Xs = self.striker.X
+        Xj = Xs[self.me]
+        for s, (nb, other) in enumerate(((left, right), (right, left))):
+            has = nb >= 0
+            self._X[:, s] = np.where(has[:, None], Xs[np.maximum(nb, 0)],
+                                     2.0 * Xj - Xs[np.maximum(other, 0)])
+            self._m[:, s] = has
+            self._src[:, s] = self.striker.vertices[self._idx[:, s]]
+        self.assignment = np.full((n_w, self.slots), -2, np.int64)
+        self.version = 0
+        self.search_count = 0
+        self.overflow = 0
+        self._searched_u: np.ndarray | None = None
+
+    def refresh(self) -> bool:
+        """Search the slots and fill X, w and m; True when some slot changed (any rank)."""
+        same = self._searched_u is not None and np.array_equal(self._searched_u, self.u.x.array)
+        if not any_rank(self.comm, not same):
+            return False
+        self._searched_u = self.u.x.array.copy()
+        us = self.striker.displacements(self.u)
+        ut = self.target.displacements(self.u)
+        scores, near = self._scores(self.striker.X + us, self.target.X + ut)
+        facet, used, dropped = pick_slots(scores, self.slots)
+        #: Striker nodes near contact (target within NEAR facet lengths) that overlap more
+        #: target facets than there are slots (owned, this rank); 0 in every test.
+        self.overflow = int(np.sum(((dropped > 0) & near)[: self.n_owned]))
+        self.search_count += 1
+        w = np.zeros_like(self._X)
+        w[:, 0], w[:, 1] = us[self._idx[:, 0]], us[self._idx[:, 1]]
+        fv = self.target.facet_vertex
+        for k in range(self.slots):
+            f = np.maximum(facet[:, k], 0)
+            on = used[:, k]
+            self._m[:, 2 + k] = on
+            for e in (0, 1):
+                vert = fv[f, e]
+                row = 2 + 2 * k + e
+                self._X[:, row] = np.where(on[:, None], self.target.X[vert],
+                                           self.striker.X[self.me])
+                w[:, row] = np.where(on[:, None], ut[vert], us[self.me])
+                self._src[:, row] = np.where(on, self.target.vertices[vert], self.block)
+        self.X.x.array[:] = self._X.reshape(-1)
+        self.w.x.array[:] = w.reshape(-1)
+        self.m.x.array[:] = self._m.reshape(-1)
+        changed = not np.array_equal(facet[: self.n_owned], self.assignment[: self.n_owned])
+        self.assignment = facet
+        if any_rank(self.comm, changed):
+            self.version += 1
+            return True
+        return False
+
+    def _scores(self, xs: np.ndarray, xt: np.ndarray) -> np.ndarray:
+        """Overlaps of the target facets with each node's two striker facets, and near contact.
+
+        ``xs``, ``xt``: current positions of the striker and target polyline vertices.
+        """
+        xt = xt[self.target.facet_vertex]
+        xj = xs[self.me]
+        x_side = [xs[self._idx[:, s]] for s in (0, 1)]
+        x_side = [np.where((self.sides[s] >= 0)[:, None], x_side[s], 2 * xj - x_side[1 - s])
+                  for s in (0, 1)]
+        scores = np.full((xj.shape[0], xt.shape[0]), -np.inf)
+        near = np.zeros(xj.shape[0], bool)
+        for s, (x1, x2) in enumerate(((x_side[0], xj), (xj, x_side[1]))):
+            sc, dist = overlaps(x1, x2, xt[:, 0], xt[:, 1], self.reach)
+            sc[self.sides[s] < 0] = -np.inf
+            near |= np.any((sc > 0.0) & (dist < NEAR), axis=1)
+            scores = np.maximum(scores, sc)
+        return scores, near
+
+    def sources(self) -> list[np.ndarray]:
+        """Global V block of each row of each owned node, shape (n_owned, rows)."""
+        return [self._src[: self.n_owned].copy()]
+
+    # -- UFL -------------------------------------------------------------------------
+    def _point(self, f: fem.Function, i: int) -> ufl.core.expr.Expr:
+        return ufl.as_vector((f[i, 0], f[i, 1]))
+
+    def nodal_gap(self, X_j: ufl.core.expr.Expr, x_j: ufl.core.expr.Expr,
+                  g_open: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+        """G_j = g~_j / A~_j at a striker node (reference ``X_j``, current ``x_j``; length)."""
+        X_nb = [self._point(self.X, s) for s in (0, 1)]
+        x_nb = [X_nb[s] + self._point(self.w, s) for s in (0, 1)]
+        facets = ((X_nb[0], x_nb[0], x_j, self.m[0], lambda xi: xi),
+                  (X_nb[1], x_j, x_nb[1], self.m[1], lambda xi: 1.0 - xi))
+        targets = [(self._point(self.X, 2 + 2 * k) + self._point(self.w, 2 + 2 * k),
+                    self._point(self.X, 3 + 2 * k) + self._point(self.w, 3 + 2 * k),
+                    self.m[2 + k]) for k in range(self.slots)]
+        weighted, area, full = 0, 0, 0
+        for Xn, x1, x2, m_f, shape in facets:
+            t = x2 - x1
+            tt = ufl.dot(t, t)
+            n_s = _perp(t) / ufl.sqrt(tt)
+            length = ufl.sqrt(ufl.dot(Xn - X_j, Xn - X_j))
+            full = full + 0.5 * m_f * length
+            for a, b, m_k in targets:
+                xa = ufl.dot(a - x1, t) / tt
+                xb = ufl.dot(b - x1, t) / tt
+                lo = ufl.max_value(ufl.min_value(xa, xb), 0.0)
+                hi = ufl.min_value(ufl.max_value(xa, xb), 1.0)
+                span = ufl.max_value(hi - lo, 0.0)
+                n_t = _perp(b - a)
+                denom = m_k * ufl.dot(n_s, n_t) - (1.0 - m_k)
+                for q, wq in _GAUSS:
+                    xi = lo + span * q
+                    alpha = ufl.dot(a - (x1 + xi * t), n_t) / denom
+                    weight = m_f * m_k * length * span * wq * shape(xi)
+                    weighted = weighted + weight * alpha
+                    area = area + weight
+        floor = 1e-8 * full
+        return ufl.conditional(ufl.gt(area, floor),
+                               weighted / ufl.max_value(area, floor), g_open)
+
+
+class MortarContact(Contact):
+    """A striker surface against a target surface of another body: 2D frictionless mortar.
+
+    Same interface as :class:`~.pairs.NodeToSegmentContact` (r relative to
+    E/h with the pair modulus 2 E_s E_t / (E_s + E_t)); see the module for
+    the formulation.
+
+    Args:
+        striker_facets, target_facets: local facet indices of the two surfaces.
+        settings: r, its scale; the quadrature must be 'nodal' (the vertex rule
+            on the nodal pairs).
+        slots: target facets a striker node may see (default from the facet sizes).
+        name: label in outputs.
+    """
+
+    def __init__(self, striker_facets: np.ndarray, target_facets: np.ndarray,
+                 settings: ContactSettings, *, striker: str | None = None,
+                 target: str | None = None, slots: int | None = None,
+                 name: str = "pair") -> None:
+        if settings.quadrature != "nodal":
+            raise ValueError("Mortar contact holds Alart-Curnier at the nodes: use quadrature = "
+                             f"'nodal', got {settings.quadrature!r}.")
+        super().__init__(striker_facets, settings, name=name)
+        self.target_facets = np.asarray(target_facets, dtype=np.int32)
+        self._names = (striker, target)
+        self._slots = slots
+        self._target_force_forms: list[fem.Form] | None = None
+
+    def _bind_partner(self, solid) -> ufl.core.expr.Expr:
+        from fenics_contact.model.pairs import _named
+
+        if solid.degree != 1 or solid.gdim != 2:
+            raise ValueError("Mortar contact needs degree = 1 and a 2D mesh in this version.")
+        overlap = np.intersect1d(self.facets, self.target_facets).size
+        if self.comm.allreduce(overlap, op=MPI.SUM):
+            raise ValueError("The striker and target facet sets share facets; a contact pair "
+                             "needs two disjoint surfaces (tag them separately).")
+        bodies = [
+            solid.body_of_facets(facets, role) if name is None else _named(solid, name, role)
+            for name, facets, role in zip(self._names, (self.facets, self.target_facets),
+                                          ("striker", "target"), strict=True)
+        ]
+        Es, Et = (b.material.E for b in bodies)
+        self.striker_body, self.target_body = bodies
+        self.modulus = 2.0 * Es * Et / (Es + Et)
+        self.mortar = MortarTransfer(solid.V, solid.u, self.surface, self.target_facets,
+                                     self._slots)
+        X = ufl.SpatialCoordinate(solid.domain)
+        self.mortar.refresh()
+        #: The gap of a node whose support meets no target facet (length; a Constant so
+        #: that the compiled forms do not depend on the mesh).
+        self.open_gap = fem.Constant(solid.domain, default_scalar_type(self.surface.h))
+        return self.mortar.nodal_gap(X, X + solid.u, self.open_gap)
+
+    def refresh(self) -> bool:
+        """Search the slots and refill the coefficients when u has changed."""
+        return self.mortar.refresh()
+
+    def extras(self) -> list[fem.Function]:
+        """The packed neighbour and slot displacements (condensed by w = S u)."""
+        return [self.mortar.w]
+
+    @property
+    def transfer(self) -> MortarTransfer:
+        """The slot search and selection (refresh, version, sources)."""
+        return self.mortar
+
+    def target_force(self) -> fem.Function:
+        """Contact force on the target's vertices, S^T dL_c/dw over the slot rows (force)."""
+        m = self.mortar
+        if self._target_force_forms is None:
+            q = ufl.TestFunction(m.W)
+            self._target_force_forms = [fem.form(ufl.derivative(self.lagrangian(), m.w, q),
+                                                 entity_maps=self.surface.entity_maps)]
+        m.refresh()
+        from petsc4py import PETSc
+
+        V = self.solid.V
+        im = V.dofmap.index_map
+        vec = PETSc.Vec().createMPI((im.size_local * 2, im.size_global * 2), bsize=2,
+                                    comm=self.comm)
+        vec.set(0.0)
+        local = fem.assemble_vector(self._target_force_forms[0])
+        local.scatter_reverse(la.InsertMode.add)
+        values = local.array[: m.n_owned * m.rows * 2].reshape(m.n_owned, m.rows, 2)[:, 2:]
+        src = m.sources()[0][:, 2:]
+        vec.setValuesBlocked(src.reshape(-1).astype(PETSc.IntType), values.reshape(-1),
+                             addv=PETSc.InsertMode.ADD)
+        vec.assemblyBegin()
+        vec.assemblyEnd()
+        out = fem.Function(V, name="target_contact_force")
+        out.x.array[: im.size_local * 2] = -vec.getArray(readonly=True)
+        out.x.scatter_forward()
+        vec.destroy()
+        return out
+
+
+__all__ = ["MortarContact", "MortarTransfer"]

@@ -1,0 +1,277 @@
+"""Mortar (segment-to-segment) pairs in 2D: patch test, tangent, strategies, scenes.
+
+Two cylinders against Hertz: tests/test_mortar_hertz.py.
+
+Every problem uses four slots so that one set of compiled forms serves the
+whole file (the first compilation of the mortar forms takes about a minute).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from dolfinx import fem
+from dolfinx.fem import petsc as fem_petsc
+
+from mpi4py import MPI
+
+from benchmarks import cases
+from fenics_contact.model.body import Body, PrescribedDisplacement, Solid
+from fenics_contact.model.contact import ContactSettings
+from fenics_contact.model.materials import material
+from fenics_contact.model.mortar import MortarContact
+from fenics_contact.model.pairs import NodeToSegmentContact
+from fenics_contact.model.problem import ContactProblem
+from fenics_contact.scene.build import build_mesh
+from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.condensed import kernel_for
+from fenics_contact.solvers.diagnostics import SolverSettings
+
+SLOTS = 4
+ROOT = Path(__file__).resolve().parents[1]
+LAW = material("linear", 200.0, 0.3)
+#: Uniaxial plane strain, total height 1, pressed by 0.01.
+PATCH_PRESSURE = -200.0 / (1 - 0.3**2) * 0.01
+
+
+#: Tags of meshes/block_on_block.geo and meshes/two_cylinders.geo: cells striker 1, target
+#: 2; facets top 2, striker face 3, target face 4, bottom 5, symmetry 6.
+STRIKER_TAG, TARGET_TAG = 1, 2
+LOAD_TAG, STRIKER_FACE_TAG, TARGET_FACE_TAG, SUPPORT_TAG, SYMMETRY_TAG = 2, 3, 4, 5, 6
+
+
+def _mesh(scene):
+    """The scene's mesh with its cell and facet tags (``mesh``, ``cell_tags``, ``facet_tags``)."""
+    body = build_mesh(scene, MPI.COMM_WORLD)
+    return SimpleNamespace(mesh=body.domain, cell_tags=body.cell_tags, facet_tags=body.facet_tags)
+
+
+def _problem(md, fixed: dict, disc: str, r: float = 1.0) -> ContactProblem:
+    ft = md.facet_tags
+    bodies = [Body("upper", STRIKER_TAG, LAW), Body("lower", TARGET_TAG, LAW)]
+    prescribed = [PrescribedDisplacement(ft.find(t), v) for t, v in fixed.items()]
+    solid = Solid(md.mesh, bodies, md.cell_tags, prescribed=prescribed)
+    args = (ft.find(STRIKER_FACE_TAG), ft.find(TARGET_FACE_TAG), ContactSettings(r=r))
+    contact = (MortarContact(*args, slots=SLOTS) if disc == "mortar"
+               else NodeToSegmentContact(*args))
+    return ContactProblem(solid, [contact])
+
+
+BLOCKS = {LOAD_TAG: (None, -0.01), SUPPORT_TAG: (None, 0.0), SYMMETRY_TAG: (0.0, None)}
+
+
+def _blocks(n_upper: int, n_lower: int, disc: str, r: float = 1.0):
+    md = _mesh(cases.block_on_block(n_upper, n_lower))
+    return _problem(md, BLOCKS, disc, r), md.facet_tags
+
+
+def _solve(problem, method: str, steps: int) -> tuple[list[int], list[list[float]]]:
+    strategy = make_strategy(method, problem, SolverSettings())
+    its, residuals = [], []
+    for i in range(1, steps + 1):
+        problem.set_load(i / steps)
+        result = strategy.solve()
+        assert result.converged, (method, i, result.status)
+        its.append(result.iterations)
+        residuals.append(list(result.residuals))
+    return its, residuals
+
+
+def _spread(problem, p: np.ndarray) -> float:
+    lo = problem.comm.allreduce(float(np.min(p, initial=np.inf)), op=MPI.MIN)
+    hi = problem.comm.allreduce(float(np.max(p, initial=-np.inf)), op=MPI.MAX)
+    return (hi - lo) / abs(PATCH_PRESSURE)
+
+
+# -- 1. patch test on non-matching meshes --------------------------------------------------
+@pytest.mark.mpi
+@pytest.mark.parametrize(("n_upper", "n_lower"), [(8, 11), (7, 5)])
+def test_mortar_patch_non_matching(n_upper: int, n_lower: int) -> None:
+    """Uniform nodal pressure to 1e-8 and force balance to 1e-10; NTS spreads on the same mesh."""
+    problem, ft = _blocks(n_upper, n_lower, "mortar")
+    _solve(problem, "gnrm", 2)
+    state = problem.contact_state()
+    np.testing.assert_allclose(state.pressure, PATCH_PRESSURE, rtol=1e-8)
+    top = problem.reaction(ft.find(LOAD_TAG))[1]
+    bottom = problem.reaction(ft.find(SUPPORT_TAG))[1]
+    assert abs(top + bottom) <= 1e-10 * state.contact_force
+    assert abs(-top - state.contact_force) <= 1e-10 * state.contact_force
+    assert state.max_penetration <= 1e-12
+    f = problem.target_force()
+    n = problem.V.dofmap.index_map.size_local
+    total = problem.comm.allreduce(f.x.array[: 2 * n].reshape(-1, 2).sum(axis=0), op=MPI.SUM)
+    assert abs(total[1] + state.contact_force) <= 1e-10 * state.contact_force
+    nts, _ = _blocks(n_upper, n_lower, "node-to-segment")
+    _solve(nts, "gnrm", 2)
+    assert _spread(nts, nts.contact_state().pressure) > 0.05
+
+
+@pytest.mark.parametrize(("method", "r"), [("penalty", 1.0), ("nua", 1.0), ("auto", 1.0),
+                                           ("sua", 0.1)])
+def test_mortar_strategies(method: str, r: float) -> None:
+    """Every strategy on the mortar patch test (SUA at r = 0.1 E/h as on NTS pairs)."""
+    problem, _ = _blocks(8, 11, "mortar", r)
+    if method == "sua":
+        strategy = make_strategy("sua", problem, SolverSettings(max_iterations=200))
+        for i in (1, 2):
+            problem.set_load(i / 2)
+            assert strategy.solve().converged
+    else:
+        _solve(problem, method, 2)
+    state = problem.contact_state()
+    if method == "penalty":  # uniform penetration p / r
+        assert 1e-4 < state.max_penetration < 1e-2
+        assert _spread(problem, state.pressure) < 1e-8
+    else:
+        np.testing.assert_allclose(state.pressure, PATCH_PRESSURE, rtol=1e-8)
+
+
+# -- 2. the tangent against finite differences ------------------------------------------------
+def _sheared(problem) -> None:
+    """Shift and bend the striker so its nodes straddle target vertices; random lam < 0."""
+    V, u = problem.V, problem.u
+    md_tags = problem.solid.cell_tags
+    tdim = problem.domain.topology.dim
+    dofs = fem.locate_dofs_topological(V, tdim, md_tags.find(STRIKER_TAG))
+    x = V.tabulate_dof_coordinates()
+    values = u.x.array.reshape(-1, 2)
+    for d in dofs:
+        X = x[d]
+        values[d] = (0.031 + 0.02 * X[1] + 0.01 * X[0] ** 2,
+                     -0.003 + 0.004 * np.sin(3.0 * X[0]) - 0.002 * (X[1] - 0.5))
+    u.x.scatter_forward()
+    rng = np.random.default_rng(3)
+    lam = problem.contact.lam
+    lam.x.array[:] = -rng.uniform(0.5, 3.0, lam.x.array.size)
+    lam.x.scatter_forward()
+
+
+def test_mortar_tangent_finite_differences() -> None:
+    """J du against central differences of the condensed residual (segments, sliding offsets)."""
+    problem, _ = _blocks(5, 7, "mortar", r=1.0)
+    _sheared(problem)
+    kernel = kernel_for(problem.augmented_system())
+    kernel._pull()
+    x0 = kernel.x.copy()
+    rng = np.random.default_rng(7)
+    du = x0.duplicate()
+    arr = rng.standard_normal(x0.getLocalSize())
+    arr[kernel._bc_local] = 0.0
+    du.setArray(arr)
+
+    def residual(x) -> np.ndarray:
+        fem_petsc.assign(x, kernel.unknowns)
+        for f in kernel.unknowns:
+            f.x.scatter_forward()
+        kernel._assemble_b()
+        return kernel.b.getArray().copy()
+
+    residual(x0)
+    kernel._assemble_A()
+    jdu = x0.duplicate()
+    kernel.A.mult(du, jdu)
+    gaps = problem.contact_state().gap
+    assert np.sum(gaps < 0) >= 2 and np.sum(gaps > 0) >= 1  # both sides of the kink
+    errors = []
+    for eps in (1e-5, 1e-6):
+        plus = x0.copy()
+        plus.axpy(eps, du)
+        minus = x0.copy()
+        minus.axpy(-eps, du)
+        fd = (residual(plus) - residual(minus)) / (2 * eps)
+        ref = jdu.getArray()
+        errors.append(np.linalg.norm(fd - ref) / np.linalg.norm(fd))
+    print("tangent relative errors", errors)
+    assert min(errors) < 1e-6, errors
+
+
+# -- scenes -------------------------------------------------------------------------------------
+def _scene_text(edit) -> str:
+    text = (ROOT / "scenes" / "block_on_block.toml").read_text()
+    return edit(text).replace("../meshes", str(ROOT / "meshes"))
+
+
+def test_mortar_scene_key_errors(tmp_path) -> None:
+    from fenics_contact.scene.schema import SceneError, load_scene
+
+    for value, message in (('"segment"', "discretisation = 'segment'"),
+                           ('"mortar"\nmu = 0.2', "mortar is frictionless")):
+        path = tmp_path / "bad.toml"
+        path.write_text(_scene_text(lambda s, v=value: s.replace(
+            'target = "target_face"', f'target = "target_face"\ndiscretisation = {v}')))
+        with pytest.raises(SceneError, match="discretisation") as err:
+            load_scene(path)
+        assert message in str(err.value)
+        assert "node-to-segment" in str(err.value)
+
+
+def test_mortar_scene_runs_end_to_end(tmp_path) -> None:
+    """`fenics-contact run` on a mortar scene: converged, XDMF and summary.json written."""
+    import json
+
+    from fenics_contact.cli import main
+
+    out = tmp_path / "run"
+    scene = ROOT / "scenes" / "block_on_block_mortar.toml"
+    assert main(["run", str(scene), "--out", str(out), "--quiet"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "converged"
+    assert summary["steps_completed"] == summary["load_steps"] == 2
+    assert (out / "solution.xdmf").is_file()
+    assert (out / "solution" / "step_0002.h5").stat().st_size > 0
+    assert abs(summary["steps"][-1]["contact_force"] + PATCH_PRESSURE) < 1e-10
+    from fenics_contact.scene.schema import load_scene
+
+    assert load_scene(ROOT / "scenes" / "two_cylinders_mortar.toml").pairs[0].discretisation \
+        == "mortar"
+
+
+def test_mortar_weighted_gap_of_a_tilted_target() -> None:
+    """G_j is the hat-weighted mean of the gap: k x_j inside, k (x_j -+ h/3) at the ends.
+
+    The target's top is tilted to y = H - k x (u_y = -k x on the lower block);
+    the striker is untouched, so its normal is (0, -1) and g(x) = k x.
+    """
+    problem, _ = _blocks(5, 7, "mortar")
+    V, u = problem.V, problem.u
+    tdim = problem.domain.topology.dim
+    dofs = fem.locate_dofs_topological(V, tdim, problem.solid.cell_tags.find(TARGET_TAG))
+    k = 0.01
+    u.x.array.reshape(-1, 2)[dofs, 1] = -k * V.tabulate_dof_coordinates()[dofs, 0]
+    u.x.scatter_forward()
+    state = problem.contact_state()
+    x = problem.nodal_coordinates()[:, 0]
+    h = 1.0 / 5
+    expected = k * np.where(x < 1e-12, h / 3, np.where(x > 1 - 1e-12, 1 - h / 3, x))
+    np.testing.assert_allclose(state.gap, expected, rtol=1e-12, atol=1e-15)
+
+
+def test_mortar_sliding_across_target_vertices() -> None:
+    """A 0.6-wide block pressed, then slid 0.15 (1.35 target facets) frictionless, 10 steps.
+
+    Measured: 4, 3, 3, ... Newton iterations (3 per sliding step), reactions
+    balanced to 1e-15, horizontal reaction at most 0.3 % of the vertical one.
+    """
+    from fenics_contact.model.body import PathDisplacement
+
+    md = _mesh(cases.block_on_block(6, 9, upper_width=0.6))
+    ft = md.facet_tags
+    bodies = [Body("upper", STRIKER_TAG, LAW), Body("lower", TARGET_TAG, LAW)]
+    path = ((0.0, 0.0, 0.0), (0.4, 0.0, -0.01), (1.0, 0.15, -0.01))
+    prescribed = [PrescribedDisplacement(ft.find(SUPPORT_TAG), (0.0, 0.0)),
+                  PathDisplacement(ft.find(LOAD_TAG), (None, None), path=path)]
+    solid = Solid(md.mesh, bodies, md.cell_tags, prescribed=prescribed)
+    contact = MortarContact(ft.find(STRIKER_FACE_TAG), ft.find(TARGET_FACE_TAG),
+                            ContactSettings(r=1.0), slots=SLOTS)
+    problem = ContactProblem(solid, [contact])
+    its, _ = _solve(problem, "gnrm", 10)
+    assert max(its) <= 4 and its[4:] == [3] * 6, its
+    assert contact.mortar.version >= 5  # the slots changed while sliding
+    top = problem.reaction(ft.find(LOAD_TAG))
+    bottom = problem.reaction(ft.find(SUPPORT_TAG))
+    assert np.all(np.abs(top + bottom) <= 1e-12)
+    assert abs(top[0]) <= 0.005 * abs(top[1])
+    assert abs(-top[1] - problem.contact_state().contact_force) <= 1e-3 * abs(top[1])
