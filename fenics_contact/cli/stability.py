@@ -7,6 +7,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
+from fenics_contact.cli.progress import progress_to_csv
 from fenics_contact.cli.study import floats, methods
 
 #: r values (relative to E/h) of ``fenics-contact stability`` by default: 1e-8 ... 1e12.
@@ -21,27 +22,24 @@ def run_grid_and_write(cases: Sequence, args: argparse.Namespace) -> int:
     """
     from mpi4py import MPI
 
-    from fenics_contact.output.io import write_csv, write_json
+    from fenics_contact.output.io import write_json
     from fenics_contact.sweeps.stability import ERROR, run_grid
     from fenics_contact.sweeps.sweep_plots import stability_plot
 
     out: Path = args.out
     rank0 = MPI.COMM_WORLD.rank == 0
-    records = []
 
-    def keep(rec) -> None:
-        records.append(rec)
-        write_csv(out / "stability.csv", [r.row() for r in records])  # survives a crash
-        if rank0:
-            print(
-                f"  {rec.case:20s} {rec.method:8s} {rec.status:15s} it {rec.iterations:5d} "
-                f"steps {rec.steps_completed}/{rec.load_steps}  {rec.wall_s:6.2f} s"
-                + ("" if rec.ft_ratio is None else f"  Ft/muN {rec.ft_ratio:.6f}")
-                + ("" if rec.reference_reached is None
-                   else "  reference " + ("reached" if rec.reference_reached else "missed"))
-                + (f"  {rec.message}" if rec.message else ""),
-                flush=True,
-            )
+    def line(rec) -> str:
+        return (
+            f"  {rec.case:20s} {rec.method:8s} {rec.status:15s} it {rec.iterations:5d} "
+            f"steps {rec.steps_completed}/{rec.load_steps}  {rec.wall_s:6.2f} s"
+            + ("" if rec.ft_ratio is None else f"  Ft/muN {rec.ft_ratio:.6f}")
+            + ("" if rec.reference_reached is None
+               else "  reference " + ("reached" if rec.reference_reached else "missed"))
+            + (f"  {rec.message}" if rec.message else "")
+        )
+
+    records, keep = progress_to_csv(out / "stability.csv", line)
 
     if rank0:
         print(f"Stability: {len(cases)} cases x {len(args.methods)} methods", flush=True)

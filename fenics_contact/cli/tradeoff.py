@@ -7,6 +7,7 @@ import math
 from collections.abc import Sequence
 from pathlib import Path
 
+from fenics_contact.cli.progress import progress_to_csv
 from fenics_contact.cli.study import floats, methods
 
 
@@ -21,21 +22,14 @@ def tradeoff_and_write(cases: Sequence, args: argparse.Namespace) -> int:
     out: Path = args.out
     rank0 = MPI.COMM_WORLD.rank == 0
 
-    done = []
-
-    def show(rec) -> None:
-        done.append(rec)
-        write_csv(out / "tradeoff.csv", [r.row() for r in done])  # survives a crash
-        if rank0:
-            last = (f"p0 err {rec.p0_error:.1e}" if math.isnan(rec.mu) else
-                    f"Ft err {rec.ft_error:.1e}  stick slip {rec.stick_slip:.1e}")
-            print(
-                f"  {rec.case:11s} {rec.mesh:9s} {rec.method:8s} r = {rec.r_relative:<8g} "
+    def line(rec) -> str:
+        last = (f"p0 err {rec.p0_error:.1e}" if math.isnan(rec.mu) else
+                f"Ft err {rec.ft_error:.1e}  stick slip {rec.stick_slip:.1e}")
+        return (f"  {rec.case:11s} {rec.mesh:9s} {rec.method:8s} r = {rec.r_relative:<8g} "
                 f"{rec.status:15s} it {rec.iterations:5d}  {rec.wall_s:7.3f} s  "
-                f"u err {rec.u_error:.1e}  {last}",
-                flush=True,
-            )
+                f"u err {rec.u_error:.1e}  {last}")
 
+    _, show = progress_to_csv(out / "tradeoff.csv", line)
     records = run_tradeoff(
         cases, args.methods, args.r, progress=show, repeats=args.repeats,
         max_iterations=args.max_iterations,

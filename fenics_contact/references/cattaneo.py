@@ -38,6 +38,7 @@ from fenics_contact.model.problem import (
 from fenics_contact.references.hertz import (
     ContactProfileFit,
     HertzSolution,
+    PlainData,
     fit_contact_profile,
     hertz_line_contact,
 )
@@ -69,7 +70,7 @@ class ContactProfile:
 
 
 @dataclass(frozen=True)
-class StickZone:
+class StickZone(PlainData):
     """Measured and analytic stick zone at one tangential load.
 
     Attributes:
@@ -101,10 +102,6 @@ class StickZone:
     traction_error: float
     stick_nodes: int
     slip_nodes: int
-
-    def to_dict(self) -> dict:
-        """Plain data."""
-        return asdict(self)
 
 
 def analytic_traction(x: np.ndarray, a: float, c: float, p0: float, mu: float) -> np.ndarray:

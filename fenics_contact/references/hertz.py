@@ -18,7 +18,7 @@ R in length units, P in stress * length).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 
 import numpy as np
 import numpy.typing as npt
@@ -54,11 +54,7 @@ def half_width(P: float, R: float, E: float, nu: float) -> float:
 def peak_pressure(P: float, R: float, E: float, nu: float) -> float:
     """Peak contact pressure p0 = sqrt(P E* / (pi R)) = 2 P / (pi a) (stress units).
 
-    Args:
-        P: normal load per unit length of the cylinder (force / length).
-        R: cylinder radius (length).
-        E: Young's modulus of the cylinder (stress).
-        nu: Poisson's ratio of the cylinder.
+    The arguments are those of :func:`half_width`.
     """
     _check_positive(P=P, R=R)
     return float(np.sqrt(P * plane_strain_modulus(E, nu) / (np.pi * R)))
@@ -81,6 +77,14 @@ def pressure_profile(x: npt.ArrayLike, p0: float, a: float) -> np.ndarray:
     _check_positive(a=a)
     xi = np.asarray(x, dtype=float) / a
     return p0 * np.sqrt(np.clip(1.0 - xi**2, 0.0, None))
+
+
+class PlainData:
+    """A comparison record that turns into plain data for JSON (``to_dict``)."""
+
+    def to_dict(self) -> dict:
+        """The fields as a plain dict (nested records too)."""
+        return asdict(self)  # type: ignore[call-overload]
 
 
 @dataclass(frozen=True)

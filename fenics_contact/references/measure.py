@@ -9,7 +9,7 @@ multiplier's sign); lengths and stresses in the scene's units.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -17,6 +17,7 @@ from fenics_contact.model.problem import ContactProblem
 from fenics_contact.references.hertz import (
     ContactProfileFit,
     HertzSolution,
+    PlainData,
     fit_contact_profile,
     hertz_line_contact,
     relative_error,
@@ -39,7 +40,7 @@ def contact_profile(problem: ContactProblem) -> tuple[np.ndarray, np.ndarray]:
 
 
 @dataclass(frozen=True)
-class HertzComparison:
+class HertzComparison(PlainData):
     """The finite element contact state against Hertz theory at the same load.
 
     Attributes:
@@ -59,10 +60,6 @@ class HertzComparison:
     p0_error: float
     nodal_peak_error: float
     max_penetration: float
-
-    def to_dict(self) -> dict:
-        """Plain-data view for JSON."""
-        return asdict(self)
 
     @classmethod
     def of(
