@@ -1,0 +1,123 @@
+"""Two cylinders against Hertz with mortar and node-to-segment pairs, on three meshes.
+
+Two identical linear-elastic half-disks (R = 1, E = 200, nu = 0.3,
+non-matching meshes: the target's contact size is 1.37 h) pushed together by
+0.02 in 6 steps (GNRM, r = 1 E/h), on h = 0.02, 0.01 and 0.005, with each
+discretisation of the pair. For each run: the largest nodal pressure against
+Hertz's p0 (two identical cylinders: R_eff = R/2, E* = E / (2 (1 - nu^2)),
+at the computed force), the relative L2 error of the nodal pressures over
+the whole zone (|x| < 1.5 a) and inside it (|x| < a - 2 h), and the Newton
+iterations. Writes ``<out>/mortar_hertz.json`` and ``.md`` and the picture
+of both profiles at h = 0.01 (``--figure``).
+
+Run: ``python benchmarks/validation/mortar_hertz.py [--out results/bench]
+[--figure docs/images/mortar_hertz.png]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+
+import numpy as np
+
+from mpi4py import MPI
+
+import fenics_contact  # noqa: F401  (the DOLFINx wheel first)
+from benchmarks.cases import two_cylinders
+from benchmarks.harness import machine, md_table, write
+from fenics_contact import build_problem, make_strategy, solve_load_path
+from fenics_contact.references.hertz import hertz_line_contact
+from fenics_contact.solvers.diagnostics import SolverSettings
+
+SIZES = (0.02, 0.01, 0.005)
+DISCRETISATIONS = ("node-to-segment", "mortar")
+
+
+def solve(h: float, discretisation: str) -> dict:
+    """One run: the nodal profile, the force and the errors against Hertz."""
+    scene = two_cylinders(h, steps=6)
+    pair = dataclasses.replace(scene.pairs[0], discretisation=discretisation)
+    problem = build_problem(dataclasses.replace(scene, pairs=(pair,)))
+    strategy = make_strategy("gnrm", problem, SolverSettings(atol=1e-10, rtol=1e-12))
+    path = solve_load_path(strategy, scene.solver.steps)
+    state = problem.contact_state()
+    comm = problem.comm
+    x = np.concatenate(comm.allgather(problem.nodal_coordinates()[:, 0]))
+    p = -np.concatenate(comm.allgather(state.pressure))
+    order = np.argsort(x)
+    x, p = x[order], p[order]
+    hertz = hertz_line_contact(state.contact_force, 0.5, 100.0, 0.3)
+    exact = hertz.pressure(x)
+
+    def l2(where: np.ndarray) -> float:
+        return float(np.sqrt(np.sum((p - exact)[where] ** 2) / np.sum(exact[where] ** 2)))
+
+    return {
+        "h": h, "discretisation": discretisation, "status": path.status,
+        "iterations": path.iterations, "force": state.contact_force,
+        "a_hertz": hertz.a, "p0_hertz": hertz.p0,
+        "peak_error": float(p.max() / hertz.p0 - 1.0),
+        "l2_whole": l2(np.abs(x) < 1.5 * hertz.a),
+        "l2_inside": l2(np.abs(x) < hertz.a - 2 * h),
+        "x": x.tolist(), "p": p.tolist(),
+    }
+
+
+def picture(runs: list[dict], h: float, path: Path) -> None:
+    """Both discretisations' nodal pressures against Hertz at mesh size h."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    chosen = [r for r in runs if r["h"] == h]
+    a, p0 = chosen[0]["a_hertz"], chosen[0]["p0_hertz"]
+    xs = np.linspace(-1.3 * a, 1.3 * a, 400)
+    ax.plot(xs / a, p0 * np.sqrt(np.clip(1 - (xs / a) ** 2, 0, None)) / p0, "k-",
+            label="Hertz, two cylinders")
+    for run, marker in zip(chosen, ("s", "o"), strict=True):
+        x, p = np.array(run["x"]), np.array(run["p"])
+        ax.plot(x / a, p / p0, marker, ms=4, mfc="none" if marker == "s" else None,
+                label=f"{run['discretisation']}: peak {run['peak_error']:+.2%}, "
+                      f"L2 inside {run['l2_inside']:.1%}")
+    ax.set_xlim(-1.4, 1.4)
+    ax.set_xlabel("x / a")
+    ax.set_ylabel("p / p0 (Hertz)")
+    ax.set_title(f"Two cylinders on non-matching meshes, h = {h:g} R")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
+
+
+def main() -> None:
+    """Command line."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=Path, default=Path("results/bench"))
+    parser.add_argument("--figure", type=Path, default=None)
+    parser.add_argument("--sizes", default=",".join(map(str, SIZES)))
+    args = parser.parse_args()
+    sizes = [float(v) for v in args.sizes.split(",")]
+    runs = [solve(h, d) for h in sizes for d in DISCRETISATIONS]
+    if MPI.COMM_WORLD.rank != 0:
+        return
+    rows = [(r["h"], r["discretisation"], r["status"], r["iterations"], r["peak_error"],
+             r["l2_whole"], r["l2_inside"]) for r in runs]
+    table = md_table(["h", "pair", "status", "Newton", "peak vs p0", "L2 |x| < 1.5 a",
+                      "L2 |x| < a - 2h"], rows)
+    summary = [{k: v for k, v in r.items() if k not in ("x", "p")} for r in runs]
+    write("mortar_hertz", {"machine": machine(), "runs": summary}, table, args.out)
+    print(table)
+    if args.figure is not None:
+        picture(runs, 0.01 if 0.01 in sizes else sizes[0], args.figure)
+        print(f"Wrote {args.figure}")
+
+
+if __name__ == "__main__":
+    main()
