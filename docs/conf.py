@@ -9,7 +9,7 @@ sys.path.insert(0, str(HERE.parent))
 
 project = "fenics-contact"
 author = "fenics-contact contributors"
-copyright = "fenics-contact contributors"  # noqa: A001
+copyright = "fenics-contact contributors"
 release = "0.1.0"
 
 extensions = [

@@ -14,7 +14,6 @@ from pathlib import Path
 
 import jupytext
 import nbformat
-
 from scene_reference import write_if_changed
 
 FOLDER = Path("_generated") / "demos"
