@@ -51,6 +51,15 @@ def test_the_check_finds_drift(change, message):
     assert message in drift(keys, docs, SECTIONS)
 
 
+def test_choices_named_in_the_reference_are_the_codes():
+    """The method and law lists of the reference are the registries'."""
+    from fenics_contact.model.materials import MATERIALS
+
+    assert all(f'"{m}"' in KEY_DOCS["solver"]["method"].type for m in spec.METHODS)
+    for section in ("material", "body"):
+        assert all(f'"{law}"' in KEY_DOCS[section]["law"].type for law in MATERIALS)
+
+
 def every_doc():
     return [(s, k, d) for s, docs in KEY_DOCS.items() for k, d in docs.items()]
 

@@ -57,6 +57,7 @@ SECTIONS: dict[str, tuple[str, str]] = {
 _TAG = "integer or string"
 _VECTOR = "array of numbers (one per dimension)"
 _BOUNDS = "array [min, max]"
+_LAW = '"svk" (or "saint-venant-kirchhoff") | "neo-hookean" (or "neohookean") | "linear"'
 _NAME = "string"
 
 #: Contact keys shared by [contact], [[obstacle]] and (partly) [[pair]].
@@ -74,7 +75,7 @@ _CONTACT: dict[str, KeyDoc] = {
     "margin": KeyDoc("number", "Extra distance beyond the obstacle's path within which facets "
                      "are candidates (with detect).", "L", field="ContactSpec.margin"),
     "r": KeyDoc("number > 0", "Penalty / augmentation parameter r (relative to E/h, h the mean "
-                "contact facet size, or absolute).", "E/h, or F/L^3 absolute",
+                "contact facet size, or absolute).", "times E/h (relative), F/L^3 (absolute)",
                 field="ContactSpec.r"),
     "relative": KeyDoc("boolean", "r is relative to E/h (true) or absolute (false).",
                        field="ContactSpec.relative"),
@@ -85,7 +86,7 @@ _CONTACT: dict[str, KeyDoc] = {
                  default="absent (frictionless)"),
     "tangential_r_max": KeyDoc("number > 0", "Cap of the tangential parameter: r_t = min(r, "
                                "tangential_r_max E/L), L the extent of the contact surface "
-                               "(needs mu).", "E/L", field="ContactSpec.tangential_r_max"),
+                               "(needs mu).", "times E/L", field="ContactSpec.tangential_r_max"),
 }
 
 #: The rigid obstacle's keys, in [obstacle] and [[obstacle]].
@@ -148,7 +149,7 @@ KEY_DOCS: dict[str, dict[str, KeyDoc]] = {
                              field="MeshSpec.parameters"),
     },
     "material": {
-        "law": KeyDoc('"svk" | "neo-hookean" | "linear"', "Strain energy: St. Venant-Kirchhoff, "
+        "law": KeyDoc(_LAW, "Strain energy: St. Venant-Kirchhoff, "
                       "compressible neo-Hookean or small-strain linear.", default="required"),
         "E": KeyDoc("number > 0", "Young's modulus.", "F/L^2", "required"),
         "nu": KeyDoc("number in (-1, 0.5)", "Poisson's ratio.", default="required"),
@@ -189,7 +190,7 @@ KEY_DOCS: dict[str, dict[str, KeyDoc]] = {
         "name": KeyDoc(_NAME, "The body's name.", default="body1, body2, ..."),
         "tag": KeyDoc(_TAG, "Cell tag (number or physical surface/volume name) of the body.",
                       default="required"),
-        "law": KeyDoc('"svk" | "neo-hookean" | "linear"', "The body's strain energy.",
+        "law": KeyDoc(_LAW, "The body's strain energy.",
                       default="required"),
         "E": KeyDoc("number > 0", "Young's modulus.", "F/L^2", "required"),
         "nu": KeyDoc("number in (-1, 0.5)", "Poisson's ratio.", default="required"),
