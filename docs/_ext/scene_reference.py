@@ -104,6 +104,13 @@ def markdown() -> str:
                 f"{cell(doc.meaning)} |"
             )
         lines.append("")
+        if section == "mesh":
+            from fenics_contact.scene.spec import GENERATOR_TAGS
+
+            tags = "; ".join(f"{g}: " + ", ".join(f"{n} = {t}" for n, t in sides.items())
+                             for g, sides in GENERATOR_TAGS.items())
+            lines += [f"Generated meshes tag their sides ({tags}); tags may be given by "
+                      "number or by name.", ""]
     return "\n".join(lines)
 
 
