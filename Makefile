@@ -8,7 +8,7 @@ MPIEXEC ?= $(shell [ -x $(BIN)/mpiexec ] && echo $(BIN)/mpiexec || echo mpiexec)
 OUT     ?= results
 
 .PHONY: demo test test-serial test-mpi soak venv meshes lint clean paper-tables paper-ex1-geometry \
-        cattaneo-mindlin tradeoff stability benchmarks
+        cattaneo-mindlin tradeoff stability benchmarks docs
 
 venv: $(VENV)/.installed
 
@@ -71,8 +71,18 @@ stability: venv
 benchmarks: venv
 	$(BIN)/python benchmarks/run_all.py --quick
 
+# The documentation site into docs/_build/html (Sphinx; warnings are errors). The
+# venv gains the `docs` extra; the demos run as notebooks at their CI size.
+docs: $(VENV)/.installed-docs
+	$(BIN)/sphinx-build -b html -W --keep-going docs docs/_build/html
+	@echo "The site: docs/_build/html/index.html"
+
+$(VENV)/.installed-docs: $(VENV)/.installed pyproject.toml
+	$(BIN)/python -m pip install --quiet -e ".[docs]"
+	@touch $@
+
 lint: venv
 	$(BIN)/ruff check fenics_contact tests demos benchmarks
 
 clean:
-	rm -rf $(VENV) $(OUT) .pytest_cache
+	rm -rf $(VENV) $(OUT) .pytest_cache docs/_build docs/_generated
