@@ -111,3 +111,29 @@ def test_pairing_mistakes_are_named(tmp_path):
         names[margin] = sorted(c.name for c in problem.contacts)
     assert names[0.18] == ["floor", "middle-on-bottom", "top-on-middle"]
     assert names[0.2] == ["floor", "middle-on-bottom", "top-on-bottom", "top-on-middle"]
+
+
+def test_a_node_touching_two_bodies_has_a_multiplier_in_each_contact(tmp_path):
+    """The top block's underside node at the joint of the two blocks it rests on."""
+    outcome = run_scene(load_scene(SCENES / "junction_blocks.toml"), tmp_path / "out",
+                        comm=MPI.COMM_SELF, pictures=False)
+    assert outcome.path.converged
+    problem = outcome.problem
+    states = problem.contact_states()
+    assert sorted(states) == ["left-floor", "right-floor", "right-on-left", "top-on-left",
+                              "top-on-right"]
+    junction = (1.0, 0.4)
+    on_left, on_right = pressures(problem, "top-on-left"), pressures(problem, "top-on-right")
+    assert junction in on_left and junction in on_right  # pressed in both contacts
+    assert max(on_left) == junction and min(on_right) == junction  # and the last of each
+    press = -problem.reaction(problem.solid.prescribed[2].facets)[1]
+    floors = states["left-floor"].contact_force + states["right-floor"].contact_force
+    assert floors == pytest.approx(press, rel=1e-10)
+    handed = 0.0
+    for name in ("top-on-left", "top-on-right"):
+        contact = next(c for c in problem.contacts if c.name == name)
+        handed -= contact.target_force().x.array.reshape(-1, 2)[:, 1].sum()
+    assert handed == pytest.approx(press, rel=1e-8)  # measured 4e-10 (the Newton tolerance)
+    # the mirror image but for the one-pass joint of the bottom blocks (measured 0.9 %)
+    left, right = states["top-on-left"].contact_force, states["top-on-right"].contact_force
+    assert left == pytest.approx(right, rel=0.02)
