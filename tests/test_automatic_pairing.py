@@ -137,3 +137,16 @@ def test_a_node_touching_two_bodies_has_a_multiplier_in_each_contact(tmp_path):
     # the mirror image but for the one-pass joint of the bottom blocks (measured 0.9 %)
     left, right = states["top-on-left"].contact_force, states["top-on-right"].contact_force
     assert left == pytest.approx(right, rel=0.02)
+
+
+@pytest.mark.mpi
+def test_automatic_pairs_on_every_process_give_the_serial_forces(tmp_path):
+    """The junction on 1 or 2 processes: every contact's serial force to 1e-8."""
+    out = Path(MPI.COMM_WORLD.bcast(str(tmp_path), root=0))
+    serial = {"right-on-left": 0.21603746971001433, "top-on-left": 1.275947239650492,
+              "top-on-right": 1.2872507754986384, "left-floor": 1.2758692401341534,
+              "right-floor": 1.2872708529163035}
+    outcome = run_scene(load_scene(SCENES / "junction_blocks.toml"), out, pictures=False)
+    assert outcome.path.converged
+    for name, state in outcome.problem.contact_states().items():
+        assert state.contact_force == pytest.approx(serial[name], rel=1e-8), name

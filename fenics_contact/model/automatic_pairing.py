@@ -83,7 +83,7 @@ def surface_box(domain: mesh.Mesh, facets: np.ndarray) -> tuple[np.ndarray, np.n
     lo = x.min(axis=0) if x.size else np.full(gdim, np.inf)
     hi = x.max(axis=0) if x.size else np.full(gdim, -np.inf)
     comm = domain.comm
-    return comm.allreduce(lo, op=MPI.MIN), comm.allreduce(hi, op=MPI.MAX)
+    return np.min(comm.allgather(lo), axis=0), np.max(comm.allgather(hi), axis=0)
 
 
 def mean_facet_size(domain: mesh.Mesh, facets: np.ndarray) -> float:
