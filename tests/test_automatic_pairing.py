@@ -111,6 +111,12 @@ def test_pairing_mistakes_are_named(tmp_path):
         names[margin] = sorted(c.name for c in problem.contacts)
     assert names[0.18] == ["floor", "middle-on-bottom", "top-on-middle"]
     assert names[0.2] == ["floor", "middle-on-bottom", "top-on-bottom", "top-on-middle"]
+    # a body pair joined by a [[pair]] is left to it: automatic pairing adds the others
+    data = tomllib.loads(path.read_text())
+    data["pair"] = [{**data["pair"][0], "name": "declared"}]
+    data["pairing"] = {"automatic": True}
+    problem = build_problem(scene_from_data(data, path), MPI.COMM_SELF)
+    assert [c.name for c in problem.contacts] == ["declared", "middle-on-bottom", "floor"]
 
 
 def test_a_node_touching_two_bodies_has_a_multiplier_in_each_contact(tmp_path):
