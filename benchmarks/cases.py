@@ -379,6 +379,43 @@ def ironing(
     })
 
 
+def _shipped(name: str) -> dict[str, Any]:
+    """The data of a shipped scene file (to vary it before validation)."""
+    import tomllib
+
+    return tomllib.loads((ROOT / "scenes" / f"{name}.toml").read_text())
+
+
+def stack_automatic(steps: int = 2) -> Scene:
+    """Three blocks stacked on a floor, pairs found automatically: the middle touches two."""
+    data = _shipped("stack_3_blocks_automatic")
+    data["solver"]["steps"] = steps
+    return _scene("stack_3_blocks_automatic", data)
+
+
+def junction_blocks(slide: float = 0.0, steps: int = 2) -> Scene:
+    """A block pressed onto two blocks side by side (a node touching both), pairs automatic.
+
+    ``slide`` > 0: the top block is pressed by 0.008 up to load factor 0.3,
+    then slides right by ``slide``: past 0.5 it leaves the left block (that
+    contact opens) while its contact with the right one closes over more nodes.
+    """
+    data = _shipped("junction_blocks")
+    data["solver"]["steps"] = steps
+    if slide:
+        top = data["dirichlet"][2]
+        top.pop("value")
+        top["path"] = [[0.0, 0.0, 0.0], [0.3, 0.0, -0.008], [1.0, slide, -0.008]]
+    return _scene("junction_blocks", data)
+
+
+def tube_crush(steps: int = 50) -> Scene:
+    """The tube crushed until its inner wall touches itself (a self-contact pair)."""
+    data = _shipped("tube_crush")
+    data["solver"]["steps"] = steps
+    return _scene("tube_crush", data)
+
+
 def build(
     scene: Scene, r: float = 1.0, relative: bool = True, quadrature: str | None = None,
     comm: MPI.Comm = MPI.COMM_WORLD,

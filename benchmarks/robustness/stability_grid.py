@@ -13,7 +13,8 @@ contact, a very coarse and a fine mesh; two deformable bodies (r, stiffness
 ratio, large sliding); the sliding block with Coulomb friction (``friction``:
 mu from 0 to 10 and a load reversal; ``friction-r``: r from 1e-8 to 1e12 E/h
 with the default cap r_t = min(r, 2 E/L) and with r_t = r); the sliding
-blocks pair with friction (``two-body-friction``, ``two-body-friction-r``).
+blocks pair with friction (``two-body-friction``, ``two-body-friction-r``);
+several contacts among several bodies and self-contact (``many-contacts``).
 The results and the picture go where ``--out`` says
 (``docs/tradeoff_and_stability.md`` shows them).
 """
@@ -33,8 +34,11 @@ from benchmarks.cases import (
     block_on_plane,
     hertz_cylinder,
     ironing,
+    junction_blocks,
     sliding_block,
     sliding_blocks,
+    stack_automatic,
+    tube_crush,
     two_cylinders,
 )
 from fenics_contact.sweeps.stability import StabilityCase
@@ -73,7 +77,24 @@ def full_grid() -> list[StabilityCase]:
         for e in (-3, 0, 3)
     ]
     cases += [StabilityCase("ironing-short", "two-body-sliding", ironing())]
-    return cases + friction_grid() + pair_friction_grid()
+    return cases + friction_grid() + pair_friction_grid() + many_contacts_grid()
+
+
+def many_contacts_grid() -> list[StabilityCase]:
+    """Several contacts among several bodies (pairs found by [pairing] automatic = true).
+
+    A body touching two others (the middle block of a stack; a block on two
+    blocks side by side, one node on both), a contact opening while another
+    closes (that block sliding off the left block onto the right one), and
+    self-contact (the tube crushed until its inner wall closes).
+    """
+    return [
+        StabilityCase("stack-automatic", "many-contacts", stack_automatic()),
+        StabilityCase("junction", "many-contacts", junction_blocks()),
+        StabilityCase("junction-slide-off", "many-contacts", junction_blocks(0.6, 10)),
+        StabilityCase("junction-r1e8", "many-contacts", junction_blocks(), 1e8),
+        StabilityCase("tube-self-contact", "many-contacts", tube_crush()),
+    ]
 
 
 def friction_grid() -> list[StabilityCase]:

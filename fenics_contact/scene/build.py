@@ -44,6 +44,7 @@ from fenics_contact.scene.checks import (
     held_by_closed_contacts,
 )
 from fenics_contact.scene.meshing import mesh_on_rank, open_geo
+from fenics_contact.scene.pairing import pairing_contacts
 from fenics_contact.scene.schema import (
     GENERATOR_TAGS,
     BoundarySpec,
@@ -354,6 +355,11 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
             striker, target, ContactSettings(r=pair.r, relative=pair.relative),
             friction=friction, name=pair.name, self_contact=pair.self_contact,
             neighbourhood=pair.neighbourhood))
+    paired = {frozenset(facet_owners(body.domain, body.cell_tags, bodies, np.concatenate(
+        [tagged_facets(body, scene, "pair", p.striker), tagged_facets(body, scene, "pair",
+                                                                      p.target)])))
+              for p in scene.pairs} if scene.pairing else set()
+    contacts += pairing_contacts(scene, body.domain, body.cell_tags, bodies, paired)
     contacts += [obstacle_contact(scene, body, entry, bodies) for entry in scene.obstacles]
     solid = Solid(body.domain, bodies, body.cell_tags, prescribed=prescribed,
                   tractions=tractions)

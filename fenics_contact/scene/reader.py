@@ -11,7 +11,8 @@ from fenics_contact.scene.spec import SceneError
 
 KEYS: dict[str, set[str]] = {
     "": {"scene", "mesh", "material", "dirichlet", "traction", "obstacle", "contact", "solver",
-         "output", "body", "pair"},
+         "output", "body", "pair", "pairing"},
+    "pairing": {"automatic", "r", "relative", "mu", "tangential_r_max", "margin"},
     "body": {"name", "tag", "law", "E", "nu"},
     "pair": {"name", "striker", "target", "r", "relative", "mu", "tangential_r_max",
              "self_contact", "neighbourhood", "discretisation"},

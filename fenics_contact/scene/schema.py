@@ -36,6 +36,8 @@ Layout (units are the user's; be consistent)::
                  r, relative, mu, tangential_r_max    } and [contact]; any
                                                       } number of pairs and
                                                       } of [[obstacle]] blocks
+    [pairing]    automatic = true (every body against every other, instead of or
+                 besides [[pair]]), r, relative, mu, tangential_r_max, margin
     [solver]     method, steps, max_iterations, atol, rtol, max_cutbacks,
                  predictor = "extrapolate" (start a step from the linear
                  extrapolation of the last two) | "previous",
@@ -74,6 +76,7 @@ from fenics_contact.scene.contact_sections import (
     read_obstacles,
     read_pairs,
 )
+from fenics_contact.scene.pairing import read_pairing
 from fenics_contact.scene.reader import _array, _check_finite, _check_keys, _Reader, _table
 from fenics_contact.scene.sections import (
     MAX_CUTBACKS,
@@ -138,7 +141,7 @@ def scene_from_data(data: dict[str, Any], path: Path | str) -> Scene:
         raise SceneError(
             f"{path.name}: [scene] dimension = {dimension!r}: use 2 (plane strain) or 3."
         )
-    if "pair" in data or "body" in data:
+    if "pair" in data or "body" in data or "pairing" in data:
         return _two_body_scene(path, data, head, dimension)
     material = _table(path, data, "material")
     law = material.choice("law", tuple(sorted(MATERIALS)))
@@ -218,20 +221,23 @@ def _two_body_scene(path: Path, data: dict[str, Any], head: _Reader, dimension: 
     bodies = read_bodies(path, data)
     pairs = read_pairs(path, data, dimension)
     obstacles = read_obstacle_blocks(path, data, dimension)
+    pairing = read_pairing(path, data)
     if len(bodies) < 2 and not any(p.self_contact for p in pairs):
         raise SceneError(f"{path.name}: {len(bodies)} [[body]] block(s); a contact pair needs "
                          "two bodies: add a [[body]] per body (name, tag, law, E, nu), or "
                          "self_contact = true in [[pair]] for a surface touching its own body.")
-    if not pairs:
+    if not pairs and pairing is None:
         raise SceneError(f"{path.name}: no [[pair]] block; add one with striker and target "
-                         "facet tags.")
+                         "facet tags, or [pairing] automatic = true.")
     names = [p.name for p in pairs] + [o.name for o in obstacles]
     if len(set(names)) != len(names):
         raise SceneError(f"{path.name}: contact names {names} repeat; give each [[pair]] and "
                          "[[obstacle]] its own name.")
-    pair = pairs[0]
+    pair = pairs[0] if pairs else PairSpec("automatic", "", "", r=pairing.r,  # type: ignore[union-attr]
+                                           relative=pairing.relative, mu=pairing.mu)  # type: ignore[union-attr]
     output = _table(path, data, "output", required=False)
     mu = next((m for m in [p.mu for p in pairs] + [o.contact.mu for o in obstacles]
+               + [pairing.mu if pairing else None]
                if m is not None), None)
     fields = _fields(output, mu, "[[pair]] or [[obstacle]]")
     mesh_spec, dirichlet, tractions = _conditions(path, data, dimension)
@@ -250,6 +256,7 @@ def _two_body_scene(path: Path, data: dict[str, Any], head: _Reader, dimension: 
         bodies=bodies,
         pairs=pairs,
         obstacles=obstacles,
+        pairing=pairing,
     )
 
 

@@ -89,6 +89,19 @@ class PairSpec:
 
 
 @dataclass(frozen=True)
+class PairingSpec:
+    """[pairing] automatic = true: every body's exterior surface against every other body's."""
+
+    r: float = 1.0
+    relative: bool = True
+    mu: float | None = None
+    tangential_r_max: float | None = 2.0
+    #: Added to the load path's largest displacement to enlarge the bodies' boxes (length);
+    #: None: a tenth of the smaller body's box diagonal.
+    margin: float | None = None
+
+
+@dataclass(frozen=True)
 class ObstacleSpec:
     """A rigid plane or ball and its motion."""
 
@@ -166,6 +179,8 @@ class Scene:
     #: named "obstacle"; [[obstacle]] blocks: one each). ``obstacle`` and
     #: ``contact`` are the first one's.
     obstacles: tuple[ObstacleContactSpec, ...] = ()
+    #: Automatic pairing of the [[body]] blocks' surfaces (None: pairs by hand only).
+    pairing: PairingSpec | None = None
 
     def __post_init__(self) -> None:
         """Keep ``obstacles`` and the first obstacle's fields one description.
@@ -188,10 +203,11 @@ class Scene:
     @property
     def two_body(self) -> bool:
         """True when the scene declares deformable bodies and contact pairs."""
-        return bool(self.pairs)
+        return bool(self.pairs) or self.pairing is not None
 
     @property
     def frictional(self) -> bool:
         """True when some contact (obstacle or pair) has a Coulomb coefficient mu."""
         return any(o.contact.mu is not None for o in self.obstacles) or any(
-            p.mu is not None for p in self.pairs)
+            p.mu is not None for p in self.pairs) or (
+            self.pairing is not None and self.pairing.mu is not None)

@@ -28,9 +28,10 @@ def with_contact_settings(
                                    quadrature=quadrature or o.contact.quadrature))
         for o in scene.obstacles
     )
+    pairing = scene.pairing and replace(scene.pairing, r=r, relative=relative)
     if len(obstacles) == 1 and scene.obstacle.type != "none":
-        return replace(scene, contact=obstacles[0].contact, pairs=pairs)
-    return replace(scene, obstacles=obstacles, pairs=pairs)
+        return replace(scene, contact=obstacles[0].contact, pairs=pairs, pairing=pairing)
+    return replace(scene, obstacles=obstacles, pairs=pairs, pairing=pairing)
 
 
 def with_solver(scene: Scene, **settings: Any) -> Scene:
