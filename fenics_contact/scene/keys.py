@@ -50,6 +50,8 @@ SECTIONS: dict[str, tuple[str, str]] = {
     "body": ("[[body]]", "One deformable body of a multi-body mesh (instead of [material])."),
     "pair": ("[[pair]]", "Contact between two deformable surfaces, or a surface and its own "
              "body (instead of [contact])."),
+    "pairing": ("[pairing]", "Automatic pairing: every body's exterior surface against every "
+                "other body's (instead of, or beside, [[pair]] blocks)."),
     "solver": ("[solver]", "Strategy, load stepping and stopping rules."),
     "output": ("[output]", "What the run writes."),
 }
@@ -124,6 +126,8 @@ KEY_DOCS: dict[str, dict[str, KeyDoc]] = {
         "body": KeyDoc("array of tables", "[[body]] blocks: deformable bodies.", default="none"),
         "pair": KeyDoc("array of tables", "[[pair]] blocks: deformable contact pairs.",
                        default="none"),
+        "pairing": KeyDoc("table", "[pairing]: automatic pairing of the bodies.",
+                          default="none"),
     },
     "scene": {
         "name": KeyDoc(_NAME, "Name of the run in messages and summary.json.",
@@ -216,6 +220,19 @@ KEY_DOCS: dict[str, dict[str, KeyDoc]] = {
         "discretisation": KeyDoc('"node-to-segment" | "mortar"', "Node-to-segment, or mortar "
                                  "(2D, frictionless; exact on non-matching meshes).",
                                  field="PairSpec.discretisation"),
+    },
+    "pairing": {
+        "automatic": KeyDoc("boolean", "Pair every body's exterior surface with every other "
+                            "body's that its load path can reach (node-to-segment; the body "
+                            "with the finer surface strikes).", default="false"),
+        "r": _CONTACT["r"]._replace(field="PairingSpec.r"),
+        "relative": _CONTACT["relative"]._replace(field="PairingSpec.relative"),
+        "mu": _CONTACT["mu"],
+        "tangential_r_max": _CONTACT["tangential_r_max"]._replace(
+            field="PairingSpec.tangential_r_max"),
+        "margin": KeyDoc("number >= 0", "Added to the load path's largest displacement to "
+                         "enlarge each body's box when deciding which bodies may meet.", "length",
+                         default="a tenth of the smaller body's box diagonal"),
     },
     "solver": {
         "method": KeyDoc('"penalty" | "sua" | "nua" | "gnrm" | "auto"', "The strategy.",
