@@ -1,0 +1,141 @@
+"""Coulomb friction on 2D mortar pairs: the sliding blocks of test_pair_friction.py, mortar.
+
+A 0.6-wide upper block (striker, 6 divisions) is pressed 0.01 onto a
+1-wide lower block (target, 9 divisions: non-matching) in 4 steps, then
+slid 0.04 in 6; mu = 0.3, r_t capped at 2 E/L as for node-to-segment.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from mpi4py import MPI
+
+from benchmarks import cases
+from benchmarks.cases import PRESS_SLIDE_PAIR
+from fenics_contact.model.friction import SLIP, STICK
+from fenics_contact.scene.build import build_mesh, build_two_body_problem
+from fenics_contact.scene.variants import with_contact_settings
+from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings
+from fenics_contact.solvers.stepping import solve_load_path
+
+MU = 0.3
+STEPS = 10
+PRESS_STEPS = 4
+#: Serial reference (GNRM, r = 1 E/h): iterations per step and final forces.
+SERIAL_ITERATIONS: list[int] = []
+SERIAL_NORMAL_FORCE = 0.0
+SERIAL_TANGENTIAL_FORCE = 0.0
+
+
+def mortar_blocks(mu: float | None = MU, r: float = 1.0):
+    """The sliding blocks with a mortar pair; ``mu = None``: frictionless."""
+    scene = with_contact_settings(cases.sliding_blocks(mu, path=PRESS_SLIDE_PAIR), r,
+                                  relative=True)
+    scene = dataclasses.replace(scene, pairs=tuple(
+        dataclasses.replace(p, discretisation="mortar") for p in scene.pairs))
+    body = build_mesh(scene)
+    return build_two_body_problem(scene, body), body
+
+
+def solve(r: float = 1.0, mu: float | None = MU):
+    problem, body = mortar_blocks(mu, r)
+    strategy = make_strategy("gnrm", problem,
+                             SolverSettings(atol=1e-8, rtol=1e-10, max_iterations=50))
+    states = []
+    run = solve_load_path(strategy, STEPS, max_cutbacks=0,
+                          on_step=lambda _: states.append(problem.contact_state()))
+    return problem, body, run, states
+
+
+@pytest.fixture(scope="module")
+def gnrm_run():
+    return solve()
+
+
+def _gathered(values: np.ndarray) -> np.ndarray:
+    return np.concatenate(MPI.COMM_WORLD.allgather(values))
+
+
+@pytest.mark.mpi
+def test_mortar_sliding_blocks_obey_coulomb(gnrm_run):
+    """Pressing sticks far below mu N; at full slip F_t = mu N to 1e-6, node by node too."""
+    _, _, run, states = gnrm_run
+    assert run.converged
+    for step in run.steps:
+        assert step.tangential_force <= MU * step.contact_force * (1 + 1e-10)
+    for step in run.steps[:PRESS_STEPS]:
+        assert step.tangential_force < 0.02 * MU * step.contact_force
+    first = run.steps[PRESS_STEPS]  # first shear step: no slip while F_t < mu N
+    assert first.slip_count == 0 and first.stick_count == first.active_count
+    assert first.tangential_force < MU * first.contact_force
+    final = run.steps[-1]
+    assert final.slip_count == final.active_count > 0 and final.stick_count == 0
+    assert final.tangential_force == pytest.approx(MU * final.contact_force, rel=1e-6)
+    state = states[-1]
+    tau = _gathered(np.abs(state.tangential_traction[:, 0]))
+    limit = _gathered(state.coulomb_limit)
+    node_state = _gathered(state.node_state)
+    np.testing.assert_allclose(tau[node_state == SLIP], limit[node_state == SLIP], rtol=1e-10)
+    assert np.all(tau[node_state == STICK] <= limit[node_state == STICK])
+
+
+@pytest.mark.mpi
+def test_mortar_friction_balance_and_target_force(gnrm_run):
+    """Top and bottom reactions balance; the force handed to the target is the top's."""
+    problem, body, _, _ = gnrm_run
+    top = problem.reaction(body.facet_tags.find(body.names["top"]))
+    bottom = problem.reaction(body.facet_tags.find(body.names["bottom"]))
+    scale = abs(top[1])
+    np.testing.assert_allclose(top + bottom, 0.0, atol=1e-10 * scale)
+    f = problem.target_force()
+    n = problem.V.dofmap.index_map.size_local
+    total = problem.comm.allreduce(f.x.array[: 2 * n].reshape(-1, 2).sum(axis=0), op=MPI.SUM)
+    np.testing.assert_allclose(total, top, atol=1e-10 * scale)
+
+
+@pytest.mark.mpi
+def test_mortar_friction_parallel_matches_serial(gnrm_run):
+    _, _, run, _ = gnrm_run
+    assert [s.iterations for s in run.steps] == SERIAL_ITERATIONS
+    final = run.steps[-1]
+    assert final.contact_force == pytest.approx(SERIAL_NORMAL_FORCE, rel=1e-10)
+    assert final.tangential_force == pytest.approx(SERIAL_TANGENTIAL_FORCE, rel=1e-10)
+
+
+def test_mortar_mu_zero_reproduces_frictionless():
+    p0, _, run0, _ = solve(mu=None)
+    p1, _, run1, _ = solve(mu=0.0)
+    assert run0.converged and run1.converged
+    assert [s.iterations for s in run1.steps] == [s.iterations for s in run0.steps]
+    assert np.max(np.abs(p1.u.x.array - p0.u.x.array)) < 1e-12
+    assert run1.steps[-1].tangential_force == 0.0
+
+
+def _order(residuals: list[float]) -> float:
+    r = [x for x in residuals if x > 0]
+    a, b, c = r[-3:]
+    return np.log(c / b) / np.log(b / a)
+
+
+def test_mortar_friction_answer_does_not_depend_on_r(gnrm_run):
+    """GNRM at r = 1e-2 and 1e2 E/h gives the r = 1 answer to 1e-8; superlinear tails."""
+    reference, _, ref_run, _ = gnrm_run
+    u_ref = reference.u.x.array
+    scale = np.max(np.abs(u_ref))
+    for r in (1e-2, 1e2):
+        problem, _, run, _ = solve(r=r)
+        assert run.converged, r
+        assert np.max(np.abs(problem.u.x.array - u_ref)) < 1e-8 * scale, r
+        final = run.steps[-1]
+        assert final.tangential_force == pytest.approx(ref_run.steps[-1].tangential_force,
+                                                       rel=1e-8), r
+        assert final.contact_force == pytest.approx(ref_run.steps[-1].contact_force,
+                                                    rel=1e-8), r
+    for step in ref_run.steps:
+        if len(step.residuals[-1]) >= 4:
+            assert _order(step.residuals[-1]) > 1.3, (step.step, step.residuals[-1])
