@@ -106,8 +106,15 @@ def test_mortar_friction_balance_and_target_force(gnrm_run):
 
 @pytest.mark.mpi
 def test_mortar_friction_parallel_matches_serial(gnrm_run):
+    """Forces to 1e-10 on 1 and 2 ranks; the Newton counts up to the first full-slip step.
+
+    Later sliding steps start far from the answer (the residual grows 20x in
+    the first iteration) and their counts follow the round-off: measured
+    [4, 3, 3, 3, 3, 5, 7, 5, 7, 5] serial, [.., 7, 5, 5, 5] and [.., 5, ..] in two runs
+    on 2 ranks.
+    """
     _, _, run, _ = gnrm_run
-    assert [s.iterations for s in run.steps] == SERIAL_ITERATIONS
+    assert [s.iterations for s in run.steps][:6] == SERIAL_ITERATIONS[:6]
     final = run.steps[-1]
     assert final.contact_force == pytest.approx(SERIAL_NORMAL_FORCE, rel=1e-10)
     assert final.tangential_force == pytest.approx(SERIAL_TANGENTIAL_FORCE, rel=1e-10)
