@@ -152,3 +152,18 @@ def test_mortar_friction_answer_does_not_depend_on_r(gnrm_run):
     for step in ref_run.steps:
         if len(step.residuals[-1]) >= 4:
             assert _order(step.residuals[-1]) > 1.3, (step.step, step.residuals[-1])
+
+
+def test_mortar_scene_takes_mu(tmp_path):
+    """A mortar [[pair]] with mu loads (it was refused while mortar was frictionless)."""
+    from pathlib import Path
+
+    from fenics_contact.scene.schema import load_scene
+
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "scenes" / "two_cylinders_mortar.toml").read_text()
+    path = tmp_path / "mortar_mu.toml"
+    path.write_text(text.replace('discretisation = "mortar"', 'discretisation = "mortar"\nmu = 0.2')
+                    .replace("../meshes", str(root / "meshes")))
+    pair = load_scene(path).pairs[0]
+    assert pair.discretisation == "mortar" and pair.mu == 0.2
