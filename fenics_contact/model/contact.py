@@ -195,9 +195,13 @@ class ContactSurface:
         im = self.Q.dofmap.index_map
         return im.size_global * self.Q.dofmap.index_map_bs
 
+    #: Compilation options of the forms on this surface (None: the defaults).
+    jit_options: dict | None = None
+
     def nodal_form(self, expr: ufl.core.expr.Expr) -> fem.Form:
         """Compile the form that gives nodal values of ``expr`` (see :meth:`nodal`)."""
-        return fem.form(expr * self._mu * self.ds_nodal, entity_maps=self.entity_maps)
+        return fem.form(expr * self._mu * self.ds_nodal, entity_maps=self.entity_maps,
+                        jit_options=self.jit_options)
 
     def nodal(self, compiled: fem.Form) -> np.ndarray:
         """Values at the owned multiplier nodes of an expression compiled by :meth:`nodal_form`.

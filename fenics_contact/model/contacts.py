@@ -47,6 +47,8 @@ class Contact:
     #: Whether lam is the contact pressure of the solution (the penalty method
     #: sets False through the problem): chooses the contact-force formula.
     multiplier_is_pressure = True
+    #: Options of the just-in-time compilation of this contact's forms (None: defaults).
+    jit_options: dict | None = None
 
     def __init__(
         self,
@@ -86,14 +88,15 @@ class Contact:
         self.Q = self.surface.Q
         self.lam = fem.Function(self.Q, name="contact_pressure")
         self.r = fem.Constant(self.domain, default_scalar_type(1.0))
+        self.surface.jit_options = self.jit_options
         self.gap = self._bind_partner(solid)
         self.set_r(self.settings.r, relative=self.settings.relative)
         self.pressure = augmented_pressure(self.gap, self.lam, self.r)
         self._gap_form = self.surface.nodal_form(self.gap)
         self._pressure_form = self.surface.nodal_form(self.pressure)
         self._force_form = fem.form(
-            -self.pressure * self.surface.ds, entity_maps=self.surface.entity_maps
-        )
+            -self.pressure * self.surface.ds, entity_maps=self.surface.entity_maps,
+            jit_options=self.jit_options)
         self._multiplier_force_form = fem.form(
             -self.lam * self.surface.ds, entity_maps=self.surface.entity_maps
         )

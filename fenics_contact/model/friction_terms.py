@@ -105,12 +105,13 @@ class CoulombFriction:
         ]
         force = self.tangents * self.traction_t
         self._tforce_forms = [
-            fem.form(force[i] * surface.ds, entity_maps=surface.entity_maps)
+            fem.form(force[i] * surface.ds, entity_maps=surface.entity_maps,
+                     jit_options=contact.jit_options)
             for i in range(gdim)
         ]
         self._tmag_form = fem.form(
             ufl.sqrt(ufl.dot(self.traction_t, self.traction_t)) * surface.ds,
-            entity_maps=surface.entity_maps,
+            entity_maps=surface.entity_maps, jit_options=contact.jit_options,
         )
         self.symmetry_constraints = self._constrain_symmetry_planes()
 
@@ -287,6 +288,7 @@ class CoulombFriction:
         self.contact.refresh()
         out = []
         for form in (self.contact.complementarity_residual(), self.tangential_residual()):
-            local = assemble_local(fem.form(form, entity_maps=self.surface.entity_maps))
+            local = assemble_local(fem.form(form, entity_maps=self.surface.entity_maps,
+                                            jit_options=self.contact.jit_options))
             out.append(self.comm.allreduce(float(local @ local), op=MPI.SUM))
         return out[0], out[1]

@@ -1,4 +1,4 @@
-"""Mortar (segment-to-segment) frictionless contact of two bodies in 2D, in UFL.
+"""Mortar (segment-to-segment) contact of two bodies in 2D, in UFL.
 
 Multiplier lam P1 on the striker's contact submesh (lam <= 0 the pressure).
 Weighted gap of striker node j, projected along the striker facet's normal
@@ -28,6 +28,8 @@ target facets a node sees) is frozen between searches.
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import numpy as np
 import ufl
 from dolfinx import default_scalar_type, fem, la
@@ -36,6 +38,8 @@ from mpi4py import MPI
 
 from fenics_contact.model.contact import ContactSettings, ContactSurface
 from fenics_contact.model.contacts import Contact
+from fenics_contact.model.friction import FrictionSettings
+from fenics_contact.model.mortar_friction import mortar_slip
 from fenics_contact.model.segments import (
     NEAR,
     REACH,
@@ -116,6 +120,7 @@ class MortarTransfer:
         self.search_count = 0
         self.overflow = 0
         self._searched_u: np.ndarray | None = None
+        self.w_prev: fem.Function | None = None
 
     def refresh(self) -> bool:
         """Search the slots and fill X, w and m; True when some slot changed (any rank)."""
@@ -131,8 +136,7 @@ class MortarTransfer:
         #: target facets than there are slots (owned, this rank); 0 in every test.
         self.overflow = int(np.sum(((dropped > 0) & near)[: self.n_owned]))
         self.search_count += 1
-        w = np.zeros_like(self._X)
-        w[:, 0], w[:, 1] = us[self._idx[:, 0]], us[self._idx[:, 1]]
+        self._picked = (facet, used)
         fv = self.target.facet_vertex
         for k in range(self.slots):
             f = np.maximum(facet[:, k], 0)
@@ -143,8 +147,10 @@ class MortarTransfer:
                 row = 2 + 2 * k + e
                 self._X[:, row] = np.where(on[:, None], self.target.X[vert],
                                            self.striker.X[self.me])
-                w[:, row] = np.where(on[:, None], ut[vert], us[self.me])
                 self._src[:, row] = np.where(on, self.target.vertices[vert], self.block)
+        w = self._select(us, ut)
+        if self.w_prev is not None:
+            self.w_prev.x.array[:] = self._select(*self._prev).reshape(-1)
         self.X.x.array[:] = self._X.reshape(-1)
         self.w.x.array[:] = w.reshape(-1)
         self.m.x.array[:] = self._m.reshape(-1)
@@ -154,6 +160,32 @@ class MortarTransfer:
             self.version += 1
             return True
         return False
+
+    def _select(self, us: np.ndarray, ut: np.ndarray) -> np.ndarray:
+        """The rows w = S u of every node from striker and target vertex displacements."""
+        facet, used = self._picked
+        w = np.zeros_like(self._X)
+        w[:, 0], w[:, 1] = us[self._idx[:, 0]], us[self._idx[:, 1]]
+        fv = self.target.facet_vertex
+        for k in range(self.slots):
+            f = np.maximum(facet[:, k], 0)
+            on = used[:, k][:, None]
+            for e in (0, 1):
+                w[:, 2 + 2 * k + e] = np.where(on, ut[fv[f, e]], us[self.me])
+        return w
+
+    def track_previous(self, u_prev: fem.Function) -> fem.Function:
+        """The rows of u_prev selected like w (data, refilled by every search)."""
+        self._u_prev = u_prev
+        self.w_prev = fem.Function(self.W, name="mortar_w_prev")
+        self.set_previous()
+        return self.w_prev
+
+    def set_previous(self) -> None:
+        """Gather u_prev on both surfaces and refill w_prev (collective)."""
+        self._prev = (self.striker.displacements(self._u_prev),
+                      self.target.displacements(self._u_prev))
+        self.w_prev.x.array[:] = self._select(*self._prev).reshape(-1)
 
     def _scores(self, xs: np.ndarray, xt: np.ndarray) -> np.ndarray:
         """Overlaps of the target facets with each node's two striker facets, and near contact.
@@ -182,24 +214,31 @@ class MortarTransfer:
     def _point(self, f: fem.Function, i: int) -> ufl.core.expr.Expr:
         return ufl.as_vector((f[i, 0], f[i, 1]))
 
-    def nodal_gap(self, X_j: ufl.core.expr.Expr, x_j: ufl.core.expr.Expr,
-                  g_open: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
-        """G_j = g~_j / A~_j at a striker node (reference ``X_j``, current ``x_j``; length)."""
+    def segments(self, X_j: ufl.core.expr.Expr, x_j: ufl.core.expr.Expr):
+        """The Gauss points of node j's segments and the full support area.
+
+        Returns (points, full): ``points`` a list of (weight, facet, slot, xi,
+        alpha) per Gauss point of every (striker facet, slot) segment, weight
+        = m_f m_k |facet| span w_q N_j(xi) (zero on an empty segment), facet
+        = (x1, x2, s) with s the neighbour row, slot k, xi the striker facet's
+        local coordinate and alpha the gap along n_s; ``full`` = A_j.
+        """
         X_nb = [self._point(self.X, s) for s in (0, 1)]
         x_nb = [X_nb[s] + self._point(self.w, s) for s in (0, 1)]
-        facets = ((X_nb[0], x_nb[0], x_j, self.m[0], lambda xi: xi),
-                  (X_nb[1], x_j, x_nb[1], self.m[1], lambda xi: 1.0 - xi))
+        facets = ((X_nb[0], x_nb[0], x_j, 0, lambda xi: xi),
+                  (X_nb[1], x_j, x_nb[1], 1, lambda xi: 1.0 - xi))
         targets = [(self._point(self.X, 2 + 2 * k) + self._point(self.w, 2 + 2 * k),
                     self._point(self.X, 3 + 2 * k) + self._point(self.w, 3 + 2 * k),
                     self.m[2 + k]) for k in range(self.slots)]
-        weighted, area, full = 0, 0, 0
-        for Xn, x1, x2, m_f, shape in facets:
+        points, full = [], 0
+        for Xn, x1, x2, s, shape in facets:
+            m_f = self.m[s]
             t = x2 - x1
             tt = ufl.dot(t, t)
             n_s = _perp(t) / ufl.sqrt(tt)
             length = ufl.sqrt(ufl.dot(Xn - X_j, Xn - X_j))
             full = full + 0.5 * m_f * length
-            for a, b, m_k in targets:
+            for k, (a, b, m_k) in enumerate(targets):
                 xa = ufl.dot(a - x1, t) / tt
                 xb = ufl.dot(b - x1, t) / tt
                 lo = ufl.max_value(ufl.min_value(xa, xb), 0.0)
@@ -211,15 +250,22 @@ class MortarTransfer:
                     xi = lo + span * q
                     alpha = ufl.dot(a - (x1 + xi * t), n_t) / denom
                     weight = m_f * m_k * length * span * wq * shape(xi)
-                    weighted = weighted + weight * alpha
-                    area = area + weight
+                    points.append((weight, (x1, x2, s, n_s), (k, a, b), xi, alpha))
+        return points, full
+
+    def nodal_gap(self, X_j: ufl.core.expr.Expr, x_j: ufl.core.expr.Expr,
+                  g_open: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+        """G_j = g~_j / A~_j at a striker node (reference ``X_j``, current ``x_j``; length)."""
+        points, full = self.segments(X_j, x_j)
+        weighted = sum(p[0] * p[4] for p in points)
+        area = sum(p[0] for p in points)
         floor = 1e-8 * full
         return ufl.conditional(ufl.gt(area, floor),
                                weighted / ufl.max_value(area, floor), g_open)
 
 
 class MortarContact(Contact):
-    """A striker surface against a target surface of another body: 2D frictionless mortar.
+    """A striker surface against a target surface of another body: 2D mortar.
 
     Same interface as :class:`~.pairs.NodeToSegmentContact` (r relative to
     E/h with the pair modulus 2 E_s E_t / (E_s + E_t)); see the module for
@@ -230,17 +276,22 @@ class MortarContact(Contact):
         settings: r, its scale; the quadrature must be 'nodal' (the vertex rule
             on the nodal pairs).
         slots: target facets a striker node may see (default from the facet sizes).
+        friction: Coulomb friction (None: frictionless); see :mod:`.mortar_friction`.
         name: label in outputs.
     """
+
+    #: The kernels are large (MBs of C): cheap C optimisation compiles them in a
+    #: fraction of the time at a small cost in assembly (docs/two_bodies.md).
+    jit_options: ClassVar[dict] = {"cffi_extra_compile_args": ["-O1", "-g0"]}
 
     def __init__(self, striker_facets: np.ndarray, target_facets: np.ndarray,
                  settings: ContactSettings, *, striker: str | None = None,
                  target: str | None = None, slots: int | None = None,
-                 name: str = "pair") -> None:
+                 friction: FrictionSettings | None = None, name: str = "pair") -> None:
         if settings.quadrature != "nodal":
             raise ValueError("Mortar contact holds Alart-Curnier at the nodes: use quadrature = "
                              f"'nodal', got {settings.quadrature!r}.")
-        super().__init__(striker_facets, settings, name=name)
+        super().__init__(striker_facets, settings, friction=friction, name=name)
         self.target_facets = np.asarray(target_facets, dtype=np.int32)
         self._names = (striker, target)
         self._slots = slots
@@ -276,6 +327,17 @@ class MortarContact(Contact):
         """Search the slots and refill the coefficients when u has changed."""
         return self.mortar.refresh()
 
+    def slip_increment(self, u_prev: fem.Function) -> tuple[ufl.core.expr.Expr, ufl.core.expr.Expr]:
+        """(T_j, s~_j): the weighted slip on the segments (:mod:`.mortar_friction`)."""
+        w_prev = self.mortar.track_previous(u_prev)
+        X = ufl.SpatialCoordinate(self.domain)
+        return mortar_slip(self.mortar, X, self.solid.u, u_prev, w_prev)
+
+    def commit_frame(self) -> None:
+        """w_prev <- the stencil rows of the new u_prev."""
+        if self.friction is not None:
+            self.mortar.set_previous()
+
     def extras(self) -> list[fem.Function]:
         """The packed neighbour and slot displacements (condensed by w = S u)."""
         return [self.mortar.w]
@@ -290,8 +352,11 @@ class MortarContact(Contact):
         m = self.mortar
         if self._target_force_forms is None:
             q = ufl.TestFunction(m.W)
-            self._target_force_forms = [fem.form(ufl.derivative(self.lagrangian(), m.w, q),
-                                                 entity_maps=self.surface.entity_maps)]
+            form = ufl.derivative(self.lagrangian(), m.w, q)
+            if self.friction is not None:
+                form += self.friction.work(self.friction.traction_t, m.w, q)
+            self._target_force_forms = [fem.form(form, entity_maps=self.surface.entity_maps,
+                                                 jit_options=self.jit_options)]
         m.refresh()
         from petsc4py import PETSc
 

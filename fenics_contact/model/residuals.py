@@ -15,7 +15,7 @@ import ufl
 from dolfinx import fem
 
 from fenics_contact.model.contacts import Contact
-from fenics_contact.model.variational_system import Transfers, VariationalSystem
+from fenics_contact.model.variational_system import Transfers, VariationalSystem, jit_options
 
 
 def frictions(contacts: Sequence[Contact]) -> list:
@@ -88,7 +88,7 @@ def energy_system(
     if extras:
         transfer = transfers[0] if len(transfers) == 1 else Transfers(transfers)
     return VariationalSystem(name, residuals, unknowns, bcs, contact_entity_maps(contacts),
-                             extras=extras, transfer=transfer)
+                             extras=extras, transfer=transfer, jit_options=jit_options(contacts))
 
 
 def complementarity_forms(contacts: Sequence[Contact]) -> list[ufl.Form]:

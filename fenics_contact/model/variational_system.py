@@ -37,6 +37,17 @@ class VariationalSystem:
     entity_maps: list = field(default_factory=list)
     extras: list[fem.Function] = field(default_factory=list)
     transfer: object | None = None
+    #: Options of the forms' just-in-time compilation (None: the defaults); a contact
+    #: with very large kernels asks for cheaper C optimisation (see :func:`jit_options`).
+    jit_options: dict | None = None
+
+
+def jit_options(contacts: Sequence[object]) -> dict | None:
+    """The compilation options the contacts ask for (``jit_options`` attribute), merged."""
+    merged: dict = {}
+    for c in contacts:
+        merged.update(getattr(c, "jit_options", None) or {})
+    return merged or None
 
 
 class Transfers:
@@ -60,4 +71,4 @@ class Transfers:
         return [s for t in self.transfers for s in t.sources()]
 
 
-__all__ = ["Transfers", "VariationalSystem", "Work"]
+__all__ = ["Transfers", "VariationalSystem", "Work", "jit_options"]

@@ -349,7 +349,7 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
                     else FrictionSettings(pair.mu, pair.tangential_r_max))
         if pair.discretisation == "mortar":
             contacts.append(MortarContact(striker, target, ContactSettings(
-                r=pair.r, relative=pair.relative), name=pair.name))
+                r=pair.r, relative=pair.relative), friction=friction, name=pair.name))
             continue
         contacts.append(NodeToSegmentContact(
             striker, target, ContactSettings(r=pair.r, relative=pair.relative),

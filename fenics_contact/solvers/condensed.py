@@ -67,10 +67,12 @@ class CondensedKernel(NewtonKernel):
         comm = self.unknowns[0].function_space.mesh.comm
         self._comm = comm
         with stopwatch(self.timings, "compile_s"):
-            self.F_ext = fem.form(system.residuals, entity_maps=system.entity_maps)
+            self.F_ext = fem.form(system.residuals, entity_maps=system.entity_maps,
+                              jit_options=system.jit_options)
             blocks = fem.forms.derivative_block(system.residuals, ext)
             blocks = [[_nonempty(f) for f in row] for row in blocks]
-            self.J_ext = fem.form(blocks, entity_maps=system.entity_maps)
+            self.J_ext = fem.form(blocks, entity_maps=system.entity_maps,
+                              jit_options=system.jit_options)
             self.A_ext = fem_petsc.create_matrix(self.J_ext, kind="mpi")
             self.ext_spaces = [f.function_space for f in ext]
             self.b_ext = fem_petsc.create_vector(self.ext_spaces, kind="mpi")

@@ -57,9 +57,11 @@ class NewtonKernel:
     ) -> None:
         self._start(system)
         with stopwatch(self.timings, "compile_s"):
-            self.F = fem.form(system.residuals, entity_maps=system.entity_maps)
+            self.F = fem.form(system.residuals, entity_maps=system.entity_maps,
+                              jit_options=system.jit_options)
             jacobian = fem.forms.derivative_block(system.residuals, system.unknowns)
-            self.J = fem.form(jacobian, entity_maps=system.entity_maps)
+            self.J = fem.form(jacobian, entity_maps=system.entity_maps,
+                              jit_options=system.jit_options)
             self.A = fem_petsc.create_matrix(self.J, kind="mpi")
             self._work_vectors()
         self._prefix = f"fc_{system.name}_{next(_prefix_counter)}_"
