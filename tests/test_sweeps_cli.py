@@ -101,7 +101,7 @@ def test_stability_two_body_friction_records_coulomb_ratio_and_reference(tmp_pat
     """
     with pytest.raises(SystemExit):
         run_cases(full_grid(), ["--help"], tmp_path)
-    assert "friction-r,two-body-friction,two-body-friction-r)" in "".join(
+    assert "friction-r,two-body-friction,two-body-friction-r," in "".join(
         capsys.readouterr().out.split())
     code = run_cases(full_grid(), ["--cases", "blocks-mu0.3,blocks-r1e12", "--methods",
                                    "gnrm,auto", "--out", str(tmp_path)], tmp_path)
