@@ -298,7 +298,7 @@ class MortarContact(Contact):
         self._target_force_forms: list[fem.Form] | None = None
 
     def _bind_partner(self, solid) -> ufl.core.expr.Expr:
-        from fenics_contact.model.pairs import _named
+        from fenics_contact.model.pairs import bind_pair_bodies
 
         if solid.degree != 1 or solid.gdim != 2:
             raise ValueError("Mortar contact needs degree = 1 and a 2D mesh in this version.")
@@ -306,14 +306,7 @@ class MortarContact(Contact):
         if self.comm.allreduce(overlap, op=MPI.SUM):
             raise ValueError("The striker and target facet sets share facets; a contact pair "
                              "needs two disjoint surfaces (tag them separately).")
-        bodies = [
-            solid.body_of_facets(facets, role) if name is None else _named(solid, name, role)
-            for name, facets, role in zip(self._names, (self.facets, self.target_facets),
-                                          ("striker", "target"), strict=True)
-        ]
-        Es, Et = (b.material.E for b in bodies)
-        self.striker_body, self.target_body = bodies
-        self.modulus = 2.0 * Es * Et / (Es + Et)
+        bind_pair_bodies(self, solid)
         self.mortar = MortarTransfer(solid.V, solid.u, self.surface, self.target_facets,
                                      self._slots)
         X = ufl.SpatialCoordinate(solid.domain)

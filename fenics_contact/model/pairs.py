@@ -34,14 +34,7 @@ from fenics_contact.model.contact import ContactSettings, ContactSurface
 from fenics_contact.model.contacts import Contact
 from fenics_contact.model.friction import FrictionSettings, tangent_basis
 from fenics_contact.model.search import SurfaceSearch, penetration_depth
-
-
-def _node_to_block(V: fem.FunctionSpace) -> np.ndarray:
-    """Local block (vertex dof) of V at each local geometry node (P1 on a P1 mesh)."""
-    geo = V.mesh.geometry
-    out = np.full(geo.x.shape[0], -1, dtype=np.int64)
-    out[geo.dofmaps[0].reshape(-1)] = V.dofmap.list.reshape(-1)
-    return out
+from fenics_contact.model.segments import node_blocks
 
 
 class DeformablePair:
@@ -100,7 +93,7 @@ class DeformablePair:
             nodes[flip] = nodes[flip][:, ::-1]
         else:
             nodes[flip] = nodes[flip][:, [0, 2, 1]]
-        node_block = _node_to_block(V)
+        node_block = node_blocks(V)
         im = V.dofmap.index_map
         gblocks = im.local_to_global(node_block[nodes].reshape(-1).astype(np.int32)).reshape(
             -1, nv
@@ -330,14 +323,7 @@ class NodeToSegmentContact(Contact):
                 "The striker and target facet sets share facets; a contact pair needs two "
                 "disjoint surfaces (tag them separately)."
             )
-        bodies = [
-            solid.body_of_facets(facets, role) if name is None else _named(solid, name, role)
-            for name, facets, role in zip(self._names, (self.facets, self.target_facets),
-                                          ("striker", "target"), strict=True)
-        ]
-        Es, Et = (b.material.E for b in bodies)
-        self.striker_body, self.target_body = bodies
-        self.modulus = 2.0 * Es * Et / (Es + Et)
+        bind_pair_bodies(self, solid)
         if self.self_contact:
             from fenics_contact.model.self_contact import SelfContactPair
 
@@ -435,6 +421,22 @@ class NodeToSegmentContact(Contact):
         out.x.scatter_forward()
         vec.destroy()
         return out
+
+
+def bind_pair_bodies(contact: Contact, solid) -> None:
+    """Set a pair's ``striker_body`` and ``target_body`` and its r scale's modulus.
+
+    The bodies are named by the contact (``_names``) or found from its facets;
+    the modulus is the harmonic mean 2 E_s E_t / (E_s + E_t) (stress).
+    """
+    bodies = [
+        solid.body_of_facets(facets, role) if name is None else _named(solid, name, role)
+        for name, facets, role in zip(contact._names, (contact.facets, contact.target_facets),
+                                      ("striker", "target"), strict=True)
+    ]
+    Es, Et = (b.material.E for b in bodies)
+    contact.striker_body, contact.target_body = bodies
+    contact.modulus = 2.0 * Es * Et / (Es + Et)
 
 
 def _named(solid, name: str, role: str) -> Body:
