@@ -74,3 +74,25 @@ def test_mortar_two_cylinders_serial_counts() -> None:
     result = _cylinders("mortar", 1.0)
     assert result["its"] == EXPECTED_ITS
     assert abs(result["force"] - EXPECTED_FORCE) <= 1e-10 * EXPECTED_FORCE
+
+
+def _pushed(steps: int) -> tuple[float, np.ndarray, list[int]]:
+    """Two cylinders (h = 0.02) pushed by 0.02 in ``steps`` equal steps: force, p, iterations."""
+    md = _mesh(cases.two_cylinders(0.02, h_far=0.2))
+    problem = _problem(md, {LOAD_TAG: (0.0, -0.02), SUPPORT_TAG: (0.0, 0.0)}, "mortar", 1.0)
+    its, _ = _solve(problem, "gnrm", steps)
+    state = problem.contact_state()
+    return state.contact_force, -np.asarray(state.pressure), its
+
+
+def test_mortar_answer_does_not_depend_on_the_load_path() -> None:
+    """The final state is the same whether it is reached in 1 or in 4 load steps (to 1e-8).
+
+    Frictionless and hyperelastic: the equilibrium at the final load is unique, and the
+    mortar weighted gaps carry no memory of earlier iterations (no facet hysteresis).
+    """
+    force_1, p_1, its_1 = _pushed(1)
+    force_4, p_4, its_4 = _pushed(4)
+    print(force_1, force_4, its_1, its_4)
+    assert abs(force_1 - force_4) <= 1e-8 * force_4
+    np.testing.assert_allclose(p_1, p_4, atol=1e-8 * p_4.max())

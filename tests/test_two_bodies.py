@@ -403,3 +403,19 @@ def test_reported_penetration_is_into_the_actual_target_surface(cylinders: dict)
     check = signorini_admissibility(problem, SolverSettings(surface_tol=1e-7))
     assert "penetration into the target surface" in check()
     assert signorini_admissibility(problem, SolverSettings())() is None
+
+
+def test_a_step_refused_by_the_surface_check_says_why() -> None:
+    """A load step whose residual converged but whose iterate the Signorini test refuses
+    fails with a message naming the refusal (not a bare ``max_iterations``) and the cure."""
+    from fenics_contact.solvers.stepping import solve_load_path
+
+    problem = _cylinders(0.02, 1e-2)
+    settings = SolverSettings(surface_tol=1e-7, max_iterations=8)
+    path = solve_load_path(make_strategy("gnrm", problem, settings), 3, max_cutbacks=1)
+    failed = path.steps[-1]
+    assert path.status == "max_iterations" and failed.status == "max_iterations"
+    assert failed.message.startswith("max_iterations at load factor")
+    assert ("the residual met its tolerance but the iterate was refused: penetration into "
+            "the target surface") in failed.message
+    assert 'discretisation = "mortar"' in failed.message

@@ -287,7 +287,9 @@ def _signorini_violation(contact, settings: SolverSettings, E: float) -> str | N
     two_body = state.constraint_penetration is not None
     if violation is None and two_body and inside > settings.surface_tol * h:
         violation = (f"penetration into the target surface {inside:.3g} > surface_tol * h = "
-                     f"{settings.surface_tol:g} * {h:.3g}")
+                     f"{settings.surface_tol:g} * {h:.3g} (a striker node held on the extension "
+                     "of a target facet it has passed, as at a concave target vertex; a mortar "
+                     "pair, discretisation = \"mortar\", measures the gap on segments instead)")
     return violation
 
 

@@ -26,7 +26,7 @@ from dataclasses import asdict, dataclass, field
 
 from fenics_contact.model.state import combined_state
 from fenics_contact.solvers.base import SolveResult, Strategy
-from fenics_contact.solvers.diagnostics import Status
+from fenics_contact.solvers.diagnostics import Status, admissibility
 
 
 @dataclass
@@ -223,7 +223,25 @@ def _attempts(record: StepRecord) -> str:
     return f"{halved + 1} attempts, the increment halved {times}"
 
 
-def _failure_message(record: StepRecord, t_try: float) -> str:
+def refusal(strategy: Strategy, result: SolveResult) -> str | None:
+    """Why a failed solve whose residual met its tolerance was not accepted, or None.
+
+    The strategy's admissibility test (prescribed displacements, Signorini,
+    Coulomb) read on the last iterate: the reason the solve kept iterating
+    although its residual had converged.
+    """
+    settings = strategy.settings
+    if not result.residuals:
+        return None
+    tolerance = max(settings.atol, settings.rtol * result.residuals[0])
+    if result.residuals[-1] > tolerance:
+        return None
+    check = admissibility(strategy.problem, settings,
+                          exact_constraint=getattr(strategy, "exact_constraint", True))
+    return None if check is None else check()
+
+
+def _failure_message(record: StepRecord, t_try: float, refused: str | None = None) -> str:
     if record.status == Status.INVERTED:
         x = ", ".join(f"{c:.4g}" for c in record.worst_cell)
         return (
@@ -232,7 +250,10 @@ def _failure_message(record: StepRecord, t_try: float) -> str:
             f"factor {t_try:.4g} after {_attempts(record)}; "
             "reduce the load, its initial penetration or r, or refine the mesh there"
         )
-    return f"{record.status} at load factor {t_try:.4g} after {_attempts(record)}"
+    message = f"{record.status} at load factor {t_try:.4g} after {_attempts(record)}"
+    if refused:
+        message += f"; the residual met its tolerance but the iterate was refused: {refused}"
+    return message
 
 
 def start_record(strategy: Strategy) -> RunRecord:
@@ -305,12 +326,13 @@ def solve_load_path(
                     halvings = 0
                     continue
                 status = Status.INVERTED
+            refused = refusal(strategy, result) if status is not Status.INVERTED else None
             problem.restore(saved)
             halvings += 1
             if halvings > max_cutbacks or increment / 2 < smallest * (1 - 1e-12):
                 step.status = status.value
                 step.load_factor = t
-                step.message = _failure_message(step, t_try)
+                step.message = _failure_message(step, t_try, refused)
                 break
             increment /= 2
             step.cutbacks += 1

@@ -1,0 +1,174 @@
+"""Frictionless ironing, mortar against node-to-segment: the horizontal reaction while sliding.
+
+Runs the ironing scene (``scenes/ironing.toml``: stiff neo-Hookean half-disk
+indenter pressed 0.1 into a softer block, then slid 2.4 radii, GNRM with the
+extrapolating predictor) twice on the same meshes: with the mortar pair and
+with the node-to-segment pair. Elastic, frictionless, quasi-static ironing
+dissipates nothing, so the indenter's horizontal reaction R_x should vanish
+in the steady part of the slide; what remains is the discretisation's
+oscillation as striker nodes cross target vertices. Reported over the
+steady window (slide/R from 0.6 to 2.4): the amplitude (max - min) / 2 and
+the RMS of R_x, their ratio mortar / node-to-segment, Newton iterations and
+the estimated order of each step.
+
+Node-to-segment at a concave vertex of the dented block holds a node on the
+extension of the facet it has passed, slightly inside the next facet; the
+library's surface check (``surface_tol`` = 1e-3 h) refuses that state. This
+comparison runs node-to-segment with ``--nts-surface-tol`` (default 1e-2)
+so that it reaches the end of the slide; the largest such depth is
+reported.
+
+Writes OUT/ironing_mortar.json, ironing_mortar.md and ironing_mortar.png.
+
+Run: ``python benchmarks/validation/ironing_mortar.py [--coarse] [--out results/bench]
+[--figure docs/images/ironing_mortar.png]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+
+from mpi4py import MPI
+
+import fenics_contact  # noqa: F401  (before dolfinx)
+from benchmarks.validation.ironing import order
+from fenics_contact.scene.build import build_mesh, build_two_body_problem, tagged_facets
+from fenics_contact.scene.schema import load_scene
+from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings
+from fenics_contact.solvers.predictor import Extrapolated
+from fenics_contact.solvers.stepping import solve_load_path
+
+ROOT = Path(__file__).resolve().parents[2]
+SCENE = ROOT / "scenes" / "ironing.toml"
+RADIUS = 0.5
+#: The steady window of the slide, in radii.
+WINDOW = (0.6, 2.4)
+DISCRETISATIONS = ("node-to-segment", "mortar")
+
+
+def run(discretisation: str, coarse: bool, surface_tol: float) -> dict:
+    """One ironing run; per-step reactions, iterations, orders and surface depths."""
+    scene = load_scene(SCENE)
+    scene = replace(scene, pairs=tuple(replace(p, discretisation=discretisation)
+                                       for p in scene.pairs))
+    if coarse:
+        scene = replace(scene, mesh=replace(scene.mesh, parameters={"h_indenter": 0.08,
+                                                                    "h_block": 0.12}))
+    body = build_mesh(scene, MPI.COMM_WORLD)
+    problem = build_two_body_problem(scene, body)
+    top = tagged_facets(body, scene, "top", "top")
+    knots = np.asarray(next(d for d in scene.dirichlet if d.path).path)
+    settings = SolverSettings(atol=scene.solver.atol, surface_tol=surface_tol)
+    strategy = Extrapolated(make_strategy("gnrm", problem, settings))
+    rows: list[dict] = []
+
+    def on_step(step) -> None:
+        force = problem.reaction(top)
+        rows.append({
+            "step": step.step, "load_factor": step.load_factor,
+            "slide_over_R": float(np.interp(step.load_factor, knots[:, 0], knots[:, 1])) / RADIUS,
+            "reaction_x": float(force[0]), "reaction_y": float(force[1]),
+            "iterations": step.iterations, "order": order(step.residuals[-1]),
+            "surface_depth": step.max_penetration,
+        })
+
+    path = solve_load_path(strategy, scene.solver.steps, max_cutbacks=4, on_step=on_step)
+    steady = [r for r in rows if WINDOW[0] <= r["slide_over_R"] <= WINDOW[1] + 1e-9]
+    rx = np.array([r["reaction_x"] for r in steady])
+    ry = np.array([r["reaction_y"] for r in steady])
+    orders = np.array([r["order"] for r in rows])
+    return {
+        "discretisation": discretisation, "status": path.status, "steps": len(rows),
+        "iterations": int(sum(r["iterations"] for r in rows)),
+        "surface_tol": surface_tol,
+        "steady_steps": len(steady),
+        "rx_amplitude": float((rx.max() - rx.min()) / 2) if rx.size else float("nan"),
+        "rx_rms": float(np.sqrt(np.mean(rx**2))) if rx.size else float("nan"),
+        "rx_mean": float(rx.mean()) if rx.size else float("nan"),
+        "ry_mean": float(ry.mean()) if ry.size else float("nan"),
+        "median_order": float(np.nanmedian(orders)), "min_order": float(np.nanmin(orders)),
+        "max_surface_depth": max(r["surface_depth"] for r in rows),
+        "rows": rows,
+    }
+
+
+def report(record: dict) -> list[str]:
+    """The markdown lines of the comparison."""
+    lines = [
+        f"# Frictionless ironing: mortar against node-to-segment ({record['mesh']} mesh)", "",
+        f"Steady window slide/R = {WINDOW[0]} ... {WINDOW[1]}; R_x should vanish there "
+        "(elastic, frictionless).", "",
+        "| pair | status | Newton its | R_x amplitude | R_x RMS | mean R_x | mean -R_y "
+        "| median order | largest surface depth |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for d in DISCRETISATIONS:
+        r = record[d]
+        lines.append(
+            f"| {d} | {r['status']} | {r['iterations']} | {r['rx_amplitude']:.4f} | "
+            f"{r['rx_rms']:.4f} | {r['rx_mean']:+.4f} | {-r['ry_mean']:.3f} | "
+            f"{r['median_order']:.2f} | {r['max_surface_depth']:.2e} |")
+    lines += ["", f"Amplitude ratio mortar / node-to-segment: {record['amplitude_ratio']:.3f}; "
+              f"RMS ratio {record['rms_ratio']:.3f}. Node-to-segment ran with surface_tol = "
+              f"{record['node-to-segment']['surface_tol']:g} h."]
+    return lines
+
+
+def figure(record: dict, path: Path) -> None:
+    """R_x against the slide for both pairs."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.5, 3.8))
+    for d, style in zip(DISCRETISATIONS, ("s-", "o-"), strict=True):
+        rows = record[d]["rows"]
+        ax.plot([r["slide_over_R"] for r in rows], [-r["reaction_x"] for r in rows], style,
+                ms=3, label=f"{d} (amplitude {record[d]['rx_amplitude']:.3f})")
+    ax.axvspan(*WINDOW, color="0.93", zorder=0, label="steady window")
+    ax.axhline(0.0, color="k", lw=0.6)
+    ax.set_xlabel("slide / R (press phase at 0)")
+    ax.set_ylabel("horizontal reaction on the indenter")
+    ax.set_title(f"Frictionless ironing (vertical reaction about "
+                 f"{-record['mortar']['ry_mean']:.1f})")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--coarse", action="store_true", help="h = 0.08 / 0.12 (tests)")
+    parser.add_argument("--nts-surface-tol", type=float, default=1e-2)
+    parser.add_argument("--out", type=Path, default=Path("results/bench"))
+    parser.add_argument("--figure", type=Path, default=None)
+    args = parser.parse_args()
+    record: dict = {"mesh": "coarse" if args.coarse else "shipped"}
+    record["node-to-segment"] = run("node-to-segment", args.coarse, args.nts_surface_tol)
+    record["mortar"] = run("mortar", args.coarse, SolverSettings().surface_tol)
+    nts, mortar = record["node-to-segment"], record["mortar"]
+    record["amplitude_ratio"] = mortar["rx_amplitude"] / nts["rx_amplitude"]
+    record["rms_ratio"] = mortar["rx_rms"] / nts["rx_rms"]
+    if MPI.COMM_WORLD.rank == 0:
+        args.out.mkdir(parents=True, exist_ok=True)
+        (args.out / "ironing_mortar.json").write_text(json.dumps(record, indent=2))
+        lines = report(record)
+        (args.out / "ironing_mortar.md").write_text("\n".join(lines) + "\n")
+        figure(record, args.figure or args.out / "ironing_mortar.png")
+        print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
