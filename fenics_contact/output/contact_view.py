@@ -19,7 +19,8 @@ laid side by side. The partner is left out, so nothing hides the contact.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -59,6 +60,22 @@ class ContactView:
         """The camera position: on +n from the focal point (length)."""
         size = float(np.max(np.ptp(np.asarray(self.surface.points), axis=0)))  # type: ignore
         return self.focal + self.normal * 4.0 * max(size, 1e-12)
+
+
+@dataclass
+class Picture:
+    """What a picture shows (rank 0): its panels and where each panel's camera looks from.
+
+    Attributes:
+        panels: panel titles, left to right.
+        directions: per 3D panel title, the unit direction from the focal point to the camera.
+        view: the 3D contact view (None in 2D or without contact).
+    """
+
+    panels: list[str] = field(default_factory=list)
+    directions: dict[str, np.ndarray] = field(default_factory=dict)
+    view: ContactView | None = None
+
 
 
 def outward_faces(grid):
@@ -285,8 +302,74 @@ def oblique_direction(normal: np.ndarray | None) -> tuple[np.ndarray, np.ndarray
     return direction / np.linalg.norm(direction), up
 
 
+def draw_solid(grid, style: dict[str, object], *, name: str, nodal: bool = False,
+               stick_slip: bool = False, context: Callable[[object, np.ndarray], None] | None
+               = None, size: int = 700):
+    """The 3D panels of one picture; returns (Picture, PyVista plotter) for the caller to save.
+
+    Left to right: the pressed surfaces seen from their partners along n,
+    then (with friction) their stick/slip map, then the whole deformed
+    ``grid`` seen aside. Without pressure only the last panel is drawn.
+
+    Args:
+        grid: the deformed bodies with :data:`PRESSURE` (and :data:`STICK_SLIP`).
+        style: ``add_mesh`` keywords of the field, ``scalars`` among them.
+        name: the field's name in the panel titles.
+        nodal: draw the field on the pressed surfaces' nodes only (a nodal state).
+        stick_slip: add the stick/slip panel when the grid has :data:`STICK_SLIP`.
+        context: ``context(plotter, bounds)`` draws what surrounds the bodies
+            (the rigid obstacles) in the last panel; bounds (2, 3), length.
+        size: the height and the width of one panel in pixels.
+    """
+    import pyvista
+
+    view = contact_view(grid)
+    stick_slip = stick_slip and view is not None and STICK_SLIP in grid.point_data
+    columns = 1 + (view is not None) + stick_slip
+    plotter = pyvista.Plotter(off_screen=True, window_size=(size * columns, size),
+                              shape=(1, columns))
+    picture = Picture(view=view)
+    panels: list[tuple[str, dict[str, object], bool]] = []
+    if view is not None:
+        panels.append((f"{name}, seen from the partner along n", style, nodal))
+    if stick_slip:
+        panels.append(("stick/slip, seen from the partner along n", stick_slip_style(), True))
+    for column, (label, look, on_nodes) in enumerate(panels):
+        plotter.subplot(0, column)
+        picture.directions[label] = add_contact_panel(
+            plotter, view, label, nodal=on_nodes, **look)  # type: ignore[arg-type]
+        picture.panels.append(label)
+    label = "deformed bodies" if BODY in grid.cell_data else "deformed body"
+    plotter.subplot(0, columns - 1)
+    plotter.add_mesh(grid.copy(), show_edges=False, **style)
+    bounds = np.array(grid.bounds).reshape(3, 2).T
+    if context is not None:
+        context(plotter, bounds)
+    direction, up = oblique_direction(None if view is None else view.normal)
+    plotter.view_vector(tuple(direction), viewup=tuple(up))
+    pad = 0.1 * float(np.max(bounds[1] - bounds[0]))
+    lo, hi = bounds[0] - pad, bounds[1] + pad
+    plotter.reset_camera(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]))
+    plotter.add_text(label, position="lower_left", font_size=10)
+    picture.directions[label] = camera_direction(plotter)
+    picture.panels.append(label)
+    return picture, plotter
+
+
 __all__ = [
-    "BODY", "PRESSURE", "STICK_SLIP", "ContactView", "add_contact_panel", "camera_direction",
-    "contact_normal", "contact_view", "look_at_contact", "oblique_direction", "outward_faces",
-    "screen_axes", "stick_slip_style",
+    "BODY",
+    "PRESSURE",
+    "STICK_SLIP",
+    "ContactView",
+    "Picture",
+    "add_contact_panel",
+    "camera_direction",
+    "contact_normal",
+    "contact_view",
+    "draw_solid",
+    "look_at_contact",
+    "oblique_direction",
+    "outward_faces",
+    "screen_axes",
+    "stick_slip_style",
 ]

@@ -14,7 +14,6 @@ bodies seen aside.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -26,29 +25,10 @@ from fenics_contact.output.contact_view import (
     BODY,
     PRESSURE,
     STICK_SLIP,
-    ContactView,
-    add_contact_panel,
-    camera_direction,
-    contact_view,
-    oblique_direction,
-    stick_slip_style,
+    Picture,
+    draw_solid,
 )
 from fenics_contact.output.io import ContactsToBody
-
-
-@dataclass
-class Picture:
-    """What a picture shows (rank 0): its panels and where each panel's camera looks from.
-
-    Attributes:
-        panels: panel titles, left to right.
-        directions: per 3D panel title, the unit direction from the focal point to the camera.
-        view: the 3D contact view (None in 2D or without contact).
-    """
-
-    panels: list[str] = field(default_factory=list)
-    directions: dict[str, np.ndarray] = field(default_factory=dict)
-    view: ContactView | None = None
 
 
 def _obstacle_mesh(problem: ContactProblem, obstacle: RigidObstacle, bounds: np.ndarray):
@@ -263,44 +243,13 @@ def _plane_picture(problem: ContactProblem, grid):
 
 def _solid_picture(problem: ContactProblem, grid):
     """3D: the pressed surfaces from their partners' side (and stick/slip), then the bodies."""
-    import pyvista
 
-    view = contact_view(grid)
-    style = _pressure_style(grid)
-    frictional = view is not None and STICK_SLIP in grid.point_data
-    columns = 1 + (view is not None) + frictional
-    plotter = pyvista.Plotter(off_screen=True, window_size=(700 * columns, 700),
-                              shape=(1, columns))
-    picture = Picture(view=view)
-    column = 0
-    if view is not None:
-        label = "contact pressure, seen from the partner along n"
-        plotter.subplot(0, column)
-        picture.directions[label] = add_contact_panel(plotter, view, label, **style)
-        picture.panels.append(label)
-        column += 1
-    if frictional:
-        label = "stick/slip, seen from the partner along n"
-        plotter.subplot(0, column)
-        picture.directions[label] = add_contact_panel(
-            plotter, view, label, nodal=True, **stick_slip_style())  # type: ignore[arg-type]
-        picture.panels.append(label)
-        column += 1
-    label = "deformed bodies" if BODY in grid.cell_data else "deformed body"
-    plotter.subplot(0, column)
-    plotter.add_mesh(grid.copy(), show_edges=False, **style)
-    bounds = np.array(grid.bounds).reshape(3, 2).T
-    near = np.concatenate([bounds[0] - 0.15 * (bounds[1] - bounds[0]),
-                           bounds[1] + 0.15 * (bounds[1] - bounds[0])])[[0, 3, 1, 4, 2, 5]]
-    for obstacle in problem.obstacles():  # only its part near the bodies
-        shape = _obstacle_mesh(problem, obstacle, bounds).clip_box(tuple(near), invert=False)
-        plotter.add_mesh(shape, color="#555555", opacity=0.3)
-    direction, up = oblique_direction(None if view is None else view.normal)
-    plotter.view_vector(tuple(direction), viewup=tuple(up))
-    pad = 0.1 * float(np.max(bounds[1] - bounds[0]))
-    lo, hi = bounds[0] - pad, bounds[1] + pad
-    plotter.reset_camera(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]))
-    plotter.add_text(label, position="lower_left", font_size=10)
-    picture.directions[label] = camera_direction(plotter)
-    picture.panels.append(label)
-    return picture, plotter
+    def obstacles(plotter, bounds: np.ndarray) -> None:
+        grow = 0.15 * (bounds[1] - bounds[0])
+        near = np.concatenate([bounds[0] - grow, bounds[1] + grow])[[0, 3, 1, 4, 2, 5]]
+        for obstacle in problem.obstacles():  # only its part near the bodies
+            shape = _obstacle_mesh(problem, obstacle, bounds).clip_box(tuple(near), invert=False)
+            plotter.add_mesh(shape, color="#555555", opacity=0.3)
+
+    return draw_solid(grid, _pressure_style(grid), name="contact pressure",
+                      stick_slip=True, context=obstacles)
