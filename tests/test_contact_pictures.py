@@ -152,3 +152,30 @@ def test_paraview_script_runs_in_pvpython(ex2, tmp_path):
                           env=env)
     assert done.returncode == 0, done.stderr
     assert png.stat().st_size > 5_000
+
+
+@pytest.mark.mpi
+def test_3d_picture_on_every_process_count(tmp_path_factory):
+    """Gathered to rank 0: each node once, every pressed node in the contact panel."""
+    comm = MPI.COMM_WORLD
+    out = Path(comm.bcast(str(tmp_path_factory.mktemp("mpi")) if comm.rank == 0 else None))
+    scene = _scene("block_3d", **{"mesh.cells": [6, 6, 3], "solver.steps": 2,
+                                  "contact.mu": 0.3})
+    outcome = run_scene(scene, out, pictures=False, comm=comm)
+    problem = outcome.problem
+    picture = deformed_contact_picture(problem, out / "deformed.png")
+    owned = problem.V.dofmap.index_map.size_local
+    pressures = [-c.contact_state().pressure for c in problem.contacts]
+    from fenics_contact.output.io import ContactsToBody
+
+    field = ContactsToBody(problem).field("p", pressures, add=True).x.array[:owned]
+    pressed = comm.allreduce(int(np.count_nonzero(field > 0)), op=MPI.SUM)
+    nodes = comm.allreduce(owned, op=MPI.SUM)
+    if comm.rank == 0:
+        assert picture.view.normal @ DOWN > 0.999
+        shown = np.asarray(picture.view.surface.point_data[PRESSURE])
+        assert np.count_nonzero(shown > 0) == pressed
+        assert _gathered_grid(problem).n_points == nodes
+    else:
+        assert picture is None
+        _gathered_grid(problem)

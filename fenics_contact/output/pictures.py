@@ -122,8 +122,8 @@ def _gathered_grid(problem: ContactProblem):
     """The deformed bodies with their contact fields, whole on rank 0 (None elsewhere).
 
     Collective. Each process contributes its owned cells and their nodes with
-    global numbers; rank 0 keeps one copy of each node, so partition
-    boundaries leave no inner faces. Several bodies get the cell field
+    global numbers; rank 0 keeps one copy of each node (its owner's), so
+    partition boundaries leave no inner faces. Several bodies get the cell field
     :data:`BODY`.
     """
     import pyvista
@@ -133,20 +133,29 @@ def _gathered_grid(problem: ContactProblem):
     points = np.array(geometry, dtype=np.float64).reshape(-1, 3)
     points[:, :gdim] += problem.u.x.array.reshape(-1, gdim)
     index_map = problem.V.dofmap.index_map
-    numbers = index_map.local_to_global(
-        np.arange(index_map.size_local + index_map.num_ghosts, dtype=np.int32))
+    local = np.arange(index_map.size_local + index_map.num_ghosts, dtype=np.int32)
+    numbers = index_map.local_to_global(local)
+    owned = local < index_map.size_local
     body = problem.body_ids()
     kinds = np.asarray(cell_types)
     bodies = (np.asarray(body.x.array[: kinds.size]).copy() if body is not None
               else np.zeros(kinds.size))
-    part = (np.asarray(topology), kinds, points, numbers, _surface_fields(problem), bodies)
+    part = (np.asarray(topology), kinds, points, numbers, owned, _surface_fields(problem),
+            bodies)
     parts = problem.comm.gather(part, root=0)
     if parts is None:
         return None
     all_numbers = np.concatenate([p[3] for p in parts])
-    _, first, renumber = np.unique(all_numbers, return_index=True, return_inverse=True)
+    all_owned = np.concatenate([p[4] for p in parts])
+    # one copy of each node, its owner's (ghost copies may hold no surface values)
+    order = np.lexsort((~all_owned, all_numbers))
+    _, first_sorted, inverse = np.unique(all_numbers[order], return_index=True,
+                                         return_inverse=True)
+    first = order[first_sorted]
+    renumber = np.empty_like(inverse)
+    renumber[order] = inverse
     cells, offset = [], 0
-    for topo, kinds_i, pts, _, _, _ in parts:
+    for topo, kinds_i, pts, *_ in parts:
         if kinds_i.size:
             per_cell = topo.reshape(kinds_i.size, -1).copy()  # one cell type a mesh
             per_cell[:, 1:] = renumber[per_cell[:, 1:] + offset]
@@ -156,10 +165,10 @@ def _gathered_grid(problem: ContactProblem):
     grid = pyvista.UnstructuredGrid(
         np.concatenate(cells), np.concatenate([p[1] for p in parts]), coords
     )
-    for name in parts[0][4]:
-        grid.point_data[name] = np.concatenate([p[4][name] for p in parts])[first]
+    for name in parts[0][5]:
+        grid.point_data[name] = np.concatenate([p[5][name] for p in parts])[first]
     if body is not None:
-        grid.cell_data[BODY] = np.concatenate([p[5] for p in parts])
+        grid.cell_data[BODY] = np.concatenate([p[6] for p in parts])
     return grid
 
 
