@@ -60,13 +60,18 @@ def _obstacle_mesh(problem: ContactProblem, obstacle: RigidObstacle, bounds: np.
 def _contact_zones(grid, size: float, most: int = 3) -> list[np.ndarray]:
     """2D: bounds around each group of pressed nodes spanning under a fifth of the body.
 
-    Pressed nodes closer than 5 % of the body's size form one group; the
-    ``most`` groups with the largest summed pressure get a window each.
+    Pressed nodes closer than 5 % of the body's size (or three times their
+    median spacing, if more) form one group; the ``most`` groups with the
+    largest summed pressure get a window each.
     """
     pressure = np.asarray(grid.point_data[PRESSURE])
     pressed = np.asarray(grid.points)[pressure > 0]
     if pressed.shape[0] == 0:
         return []
+    apart = np.linalg.norm(pressed[:, None, :] - pressed[None, :, :], axis=2)
+    np.fill_diagonal(apart, np.inf)
+    spacing = float(np.median(apart.min(axis=1))) if pressed.shape[0] > 1 else 0.0
+    near_enough = max(0.05 * size, 3.0 * spacing)
     group = -np.ones(pressed.shape[0], dtype=int)
     for seed in range(pressed.shape[0]):
         if group[seed] >= 0:
@@ -74,7 +79,7 @@ def _contact_zones(grid, size: float, most: int = 3) -> list[np.ndarray]:
         group[seed] = seed
         front = [seed]
         while front:
-            near = np.linalg.norm(pressed - pressed[front.pop()], axis=1) < 0.05 * size
+            near = np.linalg.norm(pressed - pressed[front.pop()], axis=1) < near_enough
             new = np.flatnonzero(near & (group < 0))
             group[new] = seed
             front.extend(new.tolist())
@@ -218,7 +223,13 @@ def _plane_picture(problem: ContactProblem, grid):
     nodes = pyvista.PolyData(grid.points[pressed])
     nodes.point_data[PRESSURE] = grid.point_data[PRESSURE][pressed]
     lines = _contact_lines(grid) if nodes.n_points else None
+    lift = np.array([0.0, 0.0, 1e-3 * float(np.max(bounds[1] - bounds[0]))])
+    nodes.points = np.asarray(nodes.points) + lift  # drawn over the obstacles' lines
+    if lines is not None:
+        lines.points = np.asarray(lines.points) + lift
     style = _pressure_style(grid)
+    style["scalar_bar_args"] = {"title": "contact pressure -lam", "position_x": 0.3,
+                                "position_y": 0.02, "width": 0.45, "height": 0.08}
     plotter = pyvista.Plotter(off_screen=True, window_size=(700 * (1 + len(zooms)), 700),
                               shape=(1, 1 + len(zooms)))
     views = [(bounds, "whole body")] + [
