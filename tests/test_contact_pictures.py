@@ -179,3 +179,84 @@ def test_3d_picture_on_every_process_count(tmp_path_factory):
     else:
         assert picture is None
         _gathered_grid(problem)
+
+
+_STAND_IN = '''
+"""A stand-in for paraview.simple that records what the script asks of it."""
+import json, os
+
+calls = []
+
+
+class Proxy:
+    def __init__(self, name, **kw):
+        self.__dict__["name"] = name
+        self.__dict__["props"] = dict(kw)
+        calls.append([name, {k: str(v) for k, v in kw.items()}])
+
+    def __setattr__(self, key, value):
+        calls.append([self.name + "." + key, str(value)])
+
+    def __getattr__(self, key):
+        return lambda *a, **k: calls.append([self.name + "." + key, [str(x) for x in a]])
+
+
+def OpenDataFile(path):
+    assert os.path.isfile(path), path
+    proxy = Proxy("reader", path=path)
+    proxy.__dict__["TimestepValues"] = [0.1 * k for k in range(1, 11)]
+    return proxy
+
+
+def _factory(name):
+    return lambda *a, **kw: Proxy(name, **kw)
+
+
+for _name in ("Calculator", "WarpByVector", "GetAnimationScene", "GetActiveViewOrCreate",
+              "Show"):
+    globals()[_name] = _factory(_name)
+
+
+def ColorBy(display, what):
+    calls.append(["ColorBy", list(what)])
+
+
+def ResetCamera(view):
+    calls.append(["ResetCamera", []])
+
+
+def Render(view):
+    with open(os.environ["CALLS"], "w") as f:
+        json.dump(calls, f)
+
+
+def SaveScreenshot(path, view, **kw):
+    calls.append(["SaveScreenshot", path])
+    with open(os.environ["CALLS"], "w") as f:
+        json.dump(calls, f)
+'''
+
+
+def test_paraview_script_asks_for_the_warp_the_colour_and_the_step(ex2, tmp_path):
+    """Run against a stand-in paraview.simple: the calls it makes, default and --step."""
+    import json
+    import sys
+
+    (tmp_path / "paraview").mkdir()
+    (tmp_path / "paraview" / "__init__.py").write_text("")
+    (tmp_path / "paraview" / "simple.py").write_text(_STAND_IN)
+    record = tmp_path / "calls.json"
+    env = {**os.environ, "PYTHONPATH": str(tmp_path), "CALLS": str(record)}
+    for extra, time in (([], "1.0"), (["--step", "3", "--png", "x.png"], "0.30000000000000004")):
+        done = subprocess.run([sys.executable, str(ex2 / SCRIPT), *extra], env=env,
+                              capture_output=True, text=True, timeout=60)
+        assert done.returncode == 0, done.stderr
+        calls = json.loads(record.read_text())
+        assert ["WarpByVector.Vectors", "['POINTS', 'displacement']"] in calls
+        assert ["Calculator.Function", "-contact_pressure"] in calls
+        assert ["ColorBy", ["POINTS", "contact pressure -lam"]] in calls
+        assert ["GetAnimationScene.AnimationTime", time] in calls
+    assert ["SaveScreenshot", "x.png"] in calls
+    done = subprocess.run([sys.executable, str(ex2 / SCRIPT), "--step", "11"], env=env,
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode != 0 and "load steps 1-10" in done.stderr
