@@ -230,7 +230,10 @@ def _plane_picture(problem: ContactProblem, grid):
     style = _pressure_style(grid)
     style["scalar_bar_args"] = {"title": "contact pressure -lam", "position_x": 0.3,
                                 "position_y": 0.02, "width": 0.45, "height": 0.08}
-    plotter = pyvista.Plotter(off_screen=True, window_size=(700 * (1 + len(zooms)), 700),
+    extent = bounds[1] - bounds[0]
+    wide = float(np.clip(extent[0] / max(float(extent[1]), 1e-300), 1.0, 2.0))  # alone
+    width = 700 * (1 + len(zooms)) if zooms else int(700 * wide)
+    plotter = pyvista.Plotter(off_screen=True, window_size=(width, 700),
                               shape=(1, 1 + len(zooms)))
     views = [(bounds, "whole body")] + [
         (zoom, "contact zone" if len(zooms) == 1 else f"contact zone {k + 1}")
@@ -255,6 +258,8 @@ def _plane_picture(problem: ContactProblem, grid):
         pad = 0.1 * float(np.max(window[1] - window[0]))
         lo, hi = window[0] - pad, window[1] + pad
         plotter.reset_camera(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]))
+        aspect = width / (1 + len(zooms)) / 700  # the panel's width over its height
+        plotter.camera.parallel_scale = 0.5 * max(hi[1] - lo[1], (hi[0] - lo[0]) / aspect)
         if zooms:
             plotter.add_text(label, position="lower_left", font_size=10)
         picture.panels.append(label)
