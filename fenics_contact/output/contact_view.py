@@ -217,7 +217,7 @@ def contact_view(grid, margin: float = 0.4) -> ContactView | None:
         pieces.append(piece)
         name = f"body {body}" if BODY in faces.cell_data else "body"
         top = (shift + 0.5 * (lo[0] + hi[0]) * side) * right + (hi[1] + pad[1]) * up
-        labels.append((top, f"{name}, facing {'+' if side > 0 else '-'}n"))
+        labels.append((top, name if side > 0 else f"{name}, pressed on -n (turned over)"))
     if not pieces:
         return None
     surface = pieces[0] if len(pieces) == 1 else pyvista.merge(pieces, merge_points=False)
@@ -229,13 +229,21 @@ def contact_view(grid, margin: float = 0.4) -> ContactView | None:
 
 
 def look_at_contact(plotter, view: ContactView) -> None:
-    """Put the current panel's camera on +n of the laid-out surfaces (parallel projection)."""
+    """Put the current panel's camera on +n of the laid-out surfaces (parallel projection).
+
+    The surfaces fill the left four fifths of a square panel; the colour scale
+    stands in the last fifth.
+    """
+    screen = np.asarray(view.surface.points) @ np.vstack([view.right, view.up]).T  # type: ignore
+    width, height = np.ptp(screen, axis=0)
+    scale = 0.55 * max(float(height), float(width) / 0.8)  # the right fifth: the colour scale
+    focal = view.focal + view.right * 0.2 * scale
     plotter.camera.parallel_projection = True
-    plotter.camera.focal_point = tuple(view.focal)
-    plotter.camera.position = tuple(view.position)
+    plotter.camera.focal_point = tuple(focal)
+    plotter.camera.position = tuple(focal + (view.position - view.focal))
     plotter.camera.up = tuple(view.up)
-    bounds = np.array(view.surface.bounds)  # type: ignore[attr-defined]
-    plotter.reset_camera(bounds=tuple(bounds))
+    plotter.camera.parallel_scale = scale
+    plotter.reset_camera_clipping_range()
     for where, text in view.labels:
         plotter.add_point_labels(
             np.array([where]), [text], font_size=11, point_size=1, shape_opacity=0.5,
