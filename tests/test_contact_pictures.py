@@ -260,3 +260,31 @@ def test_paraview_script_asks_for_the_warp_the_colour_and_the_step(ex2, tmp_path
     done = subprocess.run([sys.executable, str(ex2 / SCRIPT), "--step", "11"], env=env,
                           capture_output=True, text=True, timeout=60)
     assert done.returncode != 0 and "load steps 1-10" in done.stderr
+
+
+def test_surfaces_pressed_on_both_sides_are_laid_side_by_side():
+    """Two cubes, one pressed on its base (-z), the other, less, on its top (+z): n = -z,
+    the second is turned over, both are shown whole and do not overlap on the screen."""
+    import pyvista
+
+    from fenics_contact.output.contact_view import BODY, contact_view
+
+    cubes = []
+    for body, (shift, pressed_z) in enumerate([((0.0, 0.0, 0.0), 0.0), ((3.0, 0.0, 0.0), 1.0)]):
+        cube = pyvista.ImageData(dimensions=(4, 4, 4), spacing=(1 / 3,) * 3,
+                                 origin=shift).cast_to_unstructured_grid()
+        z = np.asarray(cube.points)[:, 2]
+        cube.point_data[PRESSURE] = np.where(np.isclose(z, pressed_z), 2.0 - body, 0.0)
+        cube.cell_data[BODY] = np.full(cube.n_cells, float(body))
+        cubes.append(cube)
+    grid = cubes[0].merge(cubes[1], merge_points=False)
+    view = contact_view(grid)
+    assert view.normal @ DOWN > 0.999
+    assert [text for _, text in view.labels] == ["body 0", "body 1, pressed on -n (turned over)"]
+    shown = np.asarray(view.surface.point_data[PRESSURE])
+    assert np.count_nonzero(shown == 2.0) == 16 and np.count_nonzero(shown == 1.0) == 16
+    across = np.asarray(view.surface.points) @ view.right
+    first, second = across[shown == 2.0], across[shown == 1.0]
+    assert first.max() < second.min() or second.max() < first.min()
+    depth = np.asarray(view.surface.points) @ view.normal
+    assert np.ptp(depth[shown > 0]) < 1e-12  # both pressed faces in one plane facing the camera

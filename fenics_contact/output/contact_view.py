@@ -210,13 +210,14 @@ def contact_view(grid, margin: float = 0.4) -> ContactView | None:
         piece = _piece(faces, np.flatnonzero(mask)[inside])
         turn = np.diag([1.0, float(side), float(side)])  # half a turn about screen x for -n
         coords = (np.asarray(piece.points) - centre) @ basis.T @ turn
-        shift = cursor - (lo[0] - pad[0]) if side > 0 else cursor + (hi[0] + pad[0])
+        shift = cursor - (lo[0] - pad[0])  # the half turn keeps screen x
         coords[:, 0] += shift
         piece.points = coords @ basis  # back to world axes, laid out
         cursor += float(hi[0] - lo[0] + 2 * pad[0]) * 1.15
         pieces.append(piece)
         name = f"body {body}" if BODY in faces.cell_data else "body"
-        top = (shift + 0.5 * (lo[0] + hi[0]) * side) * right + (hi[1] + pad[1]) * up
+        top = (shift + 0.5 * (lo[0] + hi[0])) * right + (
+            (hi[1] if side > 0 else -lo[1]) + pad[1]) * up
         labels.append((top, name if side > 0 else f"{name}, pressed on -n (turned over)"))
     if not pieces:
         return None
@@ -310,9 +311,12 @@ def oblique_direction(normal: np.ndarray | None) -> tuple[np.ndarray, np.ndarray
     return direction / np.linalg.norm(direction), up
 
 
+#: Draws what surrounds the bodies into a panel: ``context(plotter, bounds)``.
+Context = Callable[[object, np.ndarray], None]
+
+
 def draw_solid(grid, style: dict[str, object], *, name: str, nodal: bool = False,
-               stick_slip: bool = False, context: Callable[[object, np.ndarray], None] | None
-               = None, size: int = 700):
+               stick_slip: bool = False, context: Context | None = None, size: int = 700):
     """The 3D panels of one picture; returns (Picture, PyVista plotter) for the caller to save.
 
     Left to right: the pressed surfaces seen from their partners along n,
