@@ -12,6 +12,7 @@ from fenics_contact.model.problem import ContactProblem
 from fenics_contact.output.checkpoint import CheckpointWriter, identity, read_latest, restore
 from fenics_contact.output.folders import agree, write_failure
 from fenics_contact.output.io import write_json
+from fenics_contact.output.paraview import write_paraview_script
 from fenics_contact.output.xdmf import StepWriter
 from fenics_contact.scene.build import build_problem
 from fenics_contact.scene.schema import Scene
@@ -131,6 +132,8 @@ def run_scene(
     # an old run's checkpoint goes before its step files: never one without the other
     checkpoint = CheckpointWriter(out / "checkpoint", problem, run_identity, fresh=not resume)
     writer = StepWriter(problem, out / "solution.xdmf", scene.fields, first_step=first)
+    if comm.rank == 0:
+        write_paraview_script(out / "solution.xdmf", scene.fields, scene.dimension)
 
     def finished(step: StepRecord) -> None:
         writer.write(step.load_factor)

@@ -4,6 +4,12 @@ PyVista renders off-screen (no display needed). The body is drawn deformed
 (true scale) and coloured by the contact pressure -lam (zero off the
 contact surface, so the colour shows where and how hard the body presses);
 the rigid obstacle is drawn in grey.
+
+2D: the whole body, and beside it a window on the contact zone when it is
+small. 3D: first the pressed surfaces seen from their partners' side along
+the contact normal (:mod:`fenics_contact.output.contact_view`), with
+friction the stick/slip map on the same surfaces, then the whole deformed
+bodies seen aside.
 """
 
 from __future__ import annotations
@@ -15,6 +21,13 @@ from dolfinx import plot
 
 from fenics_contact.model.obstacles import RigidBall, RigidObstacle, RigidPlane
 from fenics_contact.model.problem import ContactProblem
+from fenics_contact.output.contact_view import (
+    BODY,
+    PRESSURE,
+    STICK_SLIP,
+    Picture,
+    draw_solid,
+)
 from fenics_contact.output.io import ContactsToBody
 
 
@@ -44,111 +57,224 @@ def _obstacle_mesh(problem: ContactProblem, obstacle: RigidObstacle, bounds: np.
     return pyvista.Sphere(radius=radius, center=centre, theta_resolution=60, phi_resolution=60)
 
 
-def _contact_window(grid, bounds: np.ndarray, gdim: int) -> np.ndarray | None:
-    """2D: bounds around the pressed nodes when they span under a fifth of the body."""
-    pressed = grid.points[grid.point_data["contact pressure"] > 0]
-    if gdim != 2 or pressed.shape[0] == 0:
-        return None
-    lo, hi = pressed.min(axis=0), pressed.max(axis=0)
-    size = float(np.max(bounds[1] - bounds[0]))
-    if float(np.max(hi - lo)) > 0.2 * size:
-        return None
-    margin = max(float(np.max(hi - lo)), 0.02 * size)
-    return np.array([lo - margin, hi + margin])
+def _contact_zones(grid, size: float, most: int = 3) -> list[np.ndarray]:
+    """2D: bounds around each group of pressed nodes spanning under a fifth of the body.
+
+    Pressed nodes closer than 5 % of the body's size (or three times their
+    median spacing, if more) form one group; the ``most`` groups with the
+    largest summed pressure get a window each.
+    """
+    pressure = np.asarray(grid.point_data[PRESSURE])
+    pressed = np.asarray(grid.points)[pressure > 0]
+    if pressed.shape[0] == 0:
+        return []
+    apart = np.linalg.norm(pressed[:, None, :] - pressed[None, :, :], axis=2)
+    np.fill_diagonal(apart, np.inf)
+    spacing = float(np.median(apart.min(axis=1))) if pressed.shape[0] > 1 else 0.0
+    near_enough = max(0.05 * size, 3.0 * spacing)
+    group = -np.ones(pressed.shape[0], dtype=int)
+    for seed in range(pressed.shape[0]):
+        if group[seed] >= 0:
+            continue
+        group[seed] = seed
+        front = [seed]
+        while front:
+            near = np.linalg.norm(pressed - pressed[front.pop()], axis=1) < near_enough
+            new = np.flatnonzero(near & (group < 0))
+            group[new] = seed
+            front.extend(new.tolist())
+    weight = pressure[pressure > 0]
+    order = sorted(set(group.tolist()), key=lambda g: -weight[group == g].sum())[:most]
+    windows = []
+    for g in sorted(order, key=lambda g: pressed[group == g][:, 0].min()):
+        points = pressed[group == g]
+        lo, hi = points.min(axis=0), points.max(axis=0)
+        if float(np.max(hi - lo)) > 0.2 * size:
+            continue
+        margin = max(float(np.max(hi - lo)), 0.025 * size)
+        windows.append(np.array([lo - margin, hi + margin]))
+    return windows
+
+
+def _contact_lines(grid):
+    """2D: the boundary edges pressed at both ends, with the pressure (PolyData)."""
+    edges = grid.extract_surface(algorithm="dataset_surface").extract_feature_edges(
+        boundary_edges=True, feature_edges=False, manifold_edges=False,
+        non_manifold_edges=False)
+    pressure = np.asarray(edges.point_data[PRESSURE])
+    lines = np.asarray(edges.lines).reshape(-1, 3)[:, 1:]
+    touching = np.flatnonzero(pressure[lines].min(axis=1) > 0)
+    return edges.extract_cells(touching)
+
+
+def _surface_fields(problem: ContactProblem) -> dict[str, np.ndarray]:
+    """Local body P1 values of the contact pressure (-lam >= 0) and, with friction, stick/slip.
+
+    A frictionless contact of a frictional problem marks its pressed nodes as
+    slipping (2), as in the XDMF output.
+    """
+    mapper = ContactsToBody(problem)
+    states = [c.contact_state() for c in problem.contacts]
+    fields = {PRESSURE: mapper.field("p", [-s.pressure for s in states], add=True).x.array}
+    if problem.frictional:
+        codes = [s.node_state.astype(float) if c.friction is not None  # type: ignore[attr-defined]
+                 else 2.0 * s.active for c, s in zip(problem.contacts, states, strict=True)]
+        fields[STICK_SLIP] = mapper.field("s", codes).x.array
+    return {name: values.copy() for name, values in fields.items()}
 
 
 def _gathered_grid(problem: ContactProblem):
-    """The deformed body with its contact pressure, whole on rank 0 (None elsewhere).
+    """The deformed bodies with their contact fields, whole on rank 0 (None elsewhere).
 
-    Collective. Each process contributes its owned cells; nodes on partition
-    boundaries appear once per process that draws a cell there (the picture
-    does not change).
+    Collective. Each process contributes its owned cells and their nodes with
+    global numbers; rank 0 keeps one copy of each node (its owner's), so
+    partition boundaries leave no inner faces. Several bodies get the cell field
+    :data:`BODY`.
     """
     import pyvista
 
-    pressures = [-c.contact_state().pressure for c in problem.contacts]
-    pressure = ContactsToBody(problem).field("p", pressures, add=True)
     topology, cell_types, geometry = plot.vtk_mesh(problem.V)
     gdim = problem.domain.geometry.dim
     points = np.array(geometry, dtype=np.float64).reshape(-1, 3)
     points[:, :gdim] += problem.u.x.array.reshape(-1, gdim)
-    part = (np.asarray(topology), np.asarray(cell_types), points, pressure.x.array.copy())
+    index_map = problem.V.dofmap.index_map
+    local = np.arange(index_map.size_local + index_map.num_ghosts, dtype=np.int32)
+    numbers = index_map.local_to_global(local)
+    owned = local < index_map.size_local
+    body = problem.body_ids()
+    kinds = np.asarray(cell_types)
+    bodies = (np.asarray(body.x.array[: kinds.size]).copy() if body is not None
+              else np.zeros(kinds.size))
+    part = (np.asarray(topology), kinds, points, numbers, owned, _surface_fields(problem),
+            bodies)
     parts = problem.comm.gather(part, root=0)
     if parts is None:
         return None
-    cells, types, coords, values = [], [], [], []
-    offset = 0
-    for topo, kinds, pts, val in parts:
-        if kinds.size:
-            per_cell = topo.reshape(kinds.size, -1).copy()  # one cell type a mesh
-            per_cell[:, 1:] += offset
+    all_numbers = np.concatenate([p[3] for p in parts])
+    all_owned = np.concatenate([p[4] for p in parts])
+    # one copy of each node, its owner's (ghost copies may hold no surface values)
+    order = np.lexsort((~all_owned, all_numbers))
+    _, first_sorted, inverse = np.unique(all_numbers[order], return_index=True,
+                                         return_inverse=True)
+    first = order[first_sorted]
+    renumber = np.empty_like(inverse)
+    renumber[order] = inverse
+    cells, offset = [], 0
+    for topo, kinds_i, pts, *_ in parts:
+        if kinds_i.size:
+            per_cell = topo.reshape(kinds_i.size, -1).copy()  # one cell type a mesh
+            per_cell[:, 1:] = renumber[per_cell[:, 1:] + offset]
             cells.append(per_cell.ravel())
-        types.append(kinds)
-        coords.append(pts)
-        values.append(val)
         offset += pts.shape[0]
+    coords = np.concatenate([p[2] for p in parts])[first]
     grid = pyvista.UnstructuredGrid(
-        np.concatenate(cells), np.concatenate(types), np.concatenate(coords)
+        np.concatenate(cells), np.concatenate([p[1] for p in parts]), coords
     )
-    grid.point_data["contact pressure"] = np.concatenate(values)
+    for name in parts[0][5]:
+        grid.point_data[name] = np.concatenate([p[5][name] for p in parts])[first]
+    if body is not None:
+        grid.cell_data[BODY] = np.concatenate([p[6] for p in parts])
     return grid
 
 
-def deformed_contact_picture(problem: ContactProblem, path: Path, title: str = "") -> None:
+def deformed_contact_picture(problem: ContactProblem, path: Path, title: str = ""
+                             ) -> Picture | None:
     """Render the deformed body coloured by contact pressure into a PNG.
 
-    Collective: on more processes the body is gathered to rank 0, which draws.
+    Collective: on more processes the body is gathered to rank 0, which draws
+    and returns what the picture shows (None on the other ranks).
     """
     import pyvista
 
     grid = _gathered_grid(problem)
     if grid is None:
-        return
+        return None
     pyvista.OFF_SCREEN = True
     # without a display VTK warns once that X is missing, then renders off-screen
     pyvista.vtk_verbosity("off")
-    gdim = problem.domain.geometry.dim
-    bounds = np.array(grid.bounds).reshape(3, 2).T
-    zoom = _contact_window(grid, bounds, gdim)
-    pressed = grid.point_data["contact pressure"] > 0
-    nodes = pyvista.PolyData(grid.points[pressed])
-    nodes.point_data["contact pressure"] = grid.point_data["contact pressure"][pressed]
-    clim = (0.0, max(float(grid.point_data["contact pressure"].max()), 1e-300))
-    shape = (1, 2) if zoom is not None else (1, 1)
-    plotter = pyvista.Plotter(
-        off_screen=True, window_size=(1600 if zoom is not None else 1200, 800), shape=shape
-    )
-    views = [(bounds, "whole body")] + ([(zoom, "contact zone")] if zoom is not None else [])
-    for column, (window, label) in enumerate(views):
-        plotter.subplot(0, column)
-        plotter.add_mesh(
-            grid.copy(), scalars="contact pressure", cmap="inferno_r", show_edges=gdim == 2,
-            edge_color="#777777", clim=clim, scalar_bar_args={"title": "contact pressure -lam"},
-        )
-        if nodes.n_points and gdim == 2:  # the pressed nodes, visible at any zoom
-            plotter.add_mesh(
-                nodes.copy(), scalars="contact pressure", cmap="inferno_r", clim=clim,
-                render_points_as_spheres=True, point_size=9 if column else 6,
-                show_scalar_bar=False,
-            )
-        for obstacle in problem.obstacles():  # deformable partners are in the grid
-            plotter.add_mesh(
-                _obstacle_mesh(problem, obstacle, bounds), color="#555555", line_width=3,
-                opacity=1.0 if gdim == 2 else 0.25,
-            )
-        if gdim == 2:
-            plotter.view_xy()
-            plotter.camera.parallel_projection = True
-        else:  # from below and aside, where the contact is usually seen
-            plotter.view_vector((1.0, -1.3, -0.8), viewup=(0.0, 0.0, 1.0))
-        pad = 0.1 * float(np.max(window[1] - window[0]))
-        lo, hi = window[0] - pad, window[1] + pad
-        plotter.reset_camera(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]))
-        if zoom is not None:
-            plotter.add_text(label, position="lower_left", font_size=10)
+    if problem.domain.geometry.dim == 2:
+        picture, plotter = _plane_picture(problem, grid)
+    else:
+        picture, plotter = _solid_picture(problem, grid)
     plotter.subplot(0, 0)
     if title:
         plotter.add_text(title, font_size=12)
     path.parent.mkdir(parents=True, exist_ok=True)
     plotter.screenshot(str(path))
     plotter.close()
+    return picture
+
+
+def _pressure_style(grid) -> dict[str, object]:
+    """``add_mesh`` keywords of the pressure colouring, one scale for every panel."""
+    top = max(float(np.max(grid.point_data[PRESSURE], initial=0.0)), 1e-300)
+    return {"scalars": PRESSURE, "cmap": "inferno_r", "clim": (0.0, top),
+            "scalar_bar_args": {"title": "p = -lam", "vertical": True,
+                                "position_x": 0.86, "position_y": 0.2, "height": 0.6}}
+
+
+def _plane_picture(problem: ContactProblem, grid):
+    """2D: the bodies in grey, the pressed boundary coloured; a window on each small zone."""
+    import pyvista
+
+    bounds = np.array(grid.bounds).reshape(3, 2).T
+    zooms = _contact_zones(grid, float(np.max(bounds[1] - bounds[0])))
+    pressed = grid.point_data[PRESSURE] > 0
+    nodes = pyvista.PolyData(grid.points[pressed])
+    nodes.point_data[PRESSURE] = grid.point_data[PRESSURE][pressed]
+    lines = _contact_lines(grid) if nodes.n_points else None
+    lift = np.array([0.0, 0.0, 1e-3 * float(np.max(bounds[1] - bounds[0]))])
+    nodes.points = np.asarray(nodes.points) + lift  # drawn over the obstacles' lines
+    if lines is not None:
+        lines.points = np.asarray(lines.points) + lift
+    style = _pressure_style(grid)
+    style["scalar_bar_args"] = {"title": "contact pressure -lam", "position_x": 0.3,
+                                "position_y": 0.02, "width": 0.45, "height": 0.08}
+    extent = bounds[1] - bounds[0]
+    wide = float(np.clip(extent[0] / max(float(extent[1]), 1e-300), 1.0, 2.0))  # alone
+    width = 700 * (1 + len(zooms)) if zooms else int(700 * wide)
+    plotter = pyvista.Plotter(off_screen=True, window_size=(width, 700),
+                              shape=(1, 1 + len(zooms)))
+    views = [(bounds, "whole body")] + [
+        (zoom, "contact zone" if len(zooms) == 1 else f"contact zone {k + 1}")
+        for k, zoom in enumerate(zooms)]
+    picture = Picture()
+    for column, (window, label) in enumerate(views):
+        plotter.subplot(0, column)
+        plotter.add_mesh(grid.copy(), color="#e4e4e4", show_edges=True, edge_color="#9a9a9a")
+        if lines is not None and lines.n_cells:  # the pressed boundary, coloured
+            plotter.add_mesh(lines.copy(), line_width=7 if column else 5, **style)
+        if nodes.n_points:  # the pressed nodes, visible at any zoom
+            plotter.add_mesh(
+                nodes.copy(), scalars=PRESSURE, cmap="inferno_r", clim=style["clim"],
+                render_points_as_spheres=True, point_size=11 if column else 7,
+                show_scalar_bar=False,
+            )
+        for obstacle in problem.obstacles():  # deformable partners are in the grid
+            plotter.add_mesh(_obstacle_mesh(problem, obstacle, bounds), color="#555555",
+                             line_width=3)
+        plotter.view_xy()
+        plotter.camera.parallel_projection = True
+        pad = 0.1 * float(np.max(window[1] - window[0]))
+        lo, hi = window[0] - pad, window[1] + pad
+        plotter.reset_camera(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]))
+        aspect = width / (1 + len(zooms)) / 700  # the panel's width over its height
+        plotter.camera.parallel_scale = 0.5 * max(hi[1] - lo[1], (hi[0] - lo[0]) / aspect)
+        if zooms:
+            plotter.add_text(label, position="lower_left", font_size=10)
+        picture.panels.append(label)
+    return picture, plotter
+
+
+def _solid_picture(problem: ContactProblem, grid):
+    """3D: the pressed surfaces from their partners' side (and stick/slip), then the bodies."""
+
+    def obstacles(plotter, bounds: np.ndarray) -> None:
+        grow = 0.15 * (bounds[1] - bounds[0])
+        near = np.concatenate([bounds[0] - grow, bounds[1] + grow])[[0, 3, 1, 4, 2, 5]]
+        for obstacle in problem.obstacles():  # only its part near the bodies
+            shape = _obstacle_mesh(problem, obstacle, bounds).clip_box(tuple(near), invert=False)
+            plotter.add_mesh(shape, color="#555555", opacity=0.3)
+
+    return draw_solid(grid, _pressure_style(grid), name="contact pressure",
+                      stick_slip=True, context=obstacles)

@@ -3,7 +3,10 @@
 Reads ``OUT/solution/step_NNNN.xdmf`` and its HDF5 file (each step's own
 files, complete once the index names them), warps the mesh by the
 displacement (true scale) and colours it by the chosen field: a point or cell
-field, vectors by their magnitude. Nothing of the run is rebuilt: no mesh
+field, vectors by their magnitude. In 3D the picture looks at the contact as
+``deformed.png`` does (:func:`fenics_contact.output.contact_view.draw_solid`):
+the pressed surfaces seen from their partners along the contact normal, then
+the whole deformed bodies. Nothing of the run is rebuilt: no mesh
 object, no forms. The HDF5 data is read with h5py: VTK's own XDMF reader
 brings a second HDF5 library that must not meet DOLFINx's in one process.
 """
@@ -15,6 +18,14 @@ from xml.etree import ElementTree
 
 import numpy as np
 
+from fenics_contact.output.contact_view import (
+    BODY,
+    PRESSURE,
+    STICK_SLIP,
+    Picture,
+    draw_solid,
+    stick_slip_style,
+)
 from fenics_contact.output.xdmf import finished_steps, step_folder
 
 #: VTK cell type of each XDMF topology DOLFINx writes (the same vertex order).
@@ -81,11 +92,19 @@ def render_step(
         step: the load step (1-based; None: the last finished one).
         field: a point or cell field of the step file; vectors are drawn by magnitude.
         path: the PNG to write (default ``OUT/render_step_NNNN_FIELD.png``).
-        window: image size in pixels.
+        window: image size in pixels (2D; in 3D the height of each panel).
 
     Returns:
         The PNG written. Raises ValueError naming the available steps or fields.
     """
+    return draw_step(out, step=step, field=field, path=path, window=window)[0]
+
+
+def draw_step(
+    out: Path, *, step: int | None = None, field: str = "contact_pressure",
+    path: Path | None = None, window: tuple[int, int] = (1200, 800),
+) -> tuple[Path, Picture]:
+    """:func:`render_step`, also returning what the picture shows (its panels and cameras)."""
     import pyvista
 
     source, chosen = _step_file(out, step)
@@ -110,22 +129,36 @@ def render_step(
     flat = float(np.ptp(np.asarray(grid.points)[:, 2])) == 0.0
     pyvista.OFF_SCREEN = True
     pyvista.vtk_verbosity("off")
-    plotter = pyvista.Plotter(off_screen=True, window_size=window)
-    plotter.add_mesh(
-        grid, scalars=label, cmap=_CMAPS.get(field, "viridis"), show_edges=flat,
-        edge_color="#777777", scalar_bar_args={"title": label},
-    )
+    style: dict[str, object] = {
+        "scalars": label, "cmap": _CMAPS.get(field, "viridis"),
+        "scalar_bar_args": {"title": label}}
     if flat:
+        picture = Picture(panels=[label])
+        plotter = pyvista.Plotter(off_screen=True, window_size=window)
+        plotter.add_mesh(grid, show_edges=True, edge_color="#777777", **style)
         plotter.view_xy()
         plotter.camera.parallel_projection = True
     else:
-        plotter.view_vector((1.0, -1.3, -0.8), viewup=(0.0, 0.0, 1.0))
+        if "contact_pressure" in grid.point_data:
+            grid.point_data[PRESSURE] = -np.asarray(grid.point_data["contact_pressure"])
+        if "stick_slip" in grid.point_data:
+            grid.point_data[STICK_SLIP] = np.asarray(grid.point_data["stick_slip"])
+        if "body_id" in grid.cell_data:
+            grid.cell_data[BODY] = np.asarray(grid.cell_data["body_id"])
+        style["scalar_bar_args"] = {"title": label, "vertical": True, "position_x": 0.86,
+                                    "position_y": 0.2, "height": 0.6}
+        if field == "stick_slip":
+            style = stick_slip_style()
+        picture, plotter = draw_solid(
+            grid, style, name=label, nodal=field in ("stick_slip", "active"),
+            size=window[1])
+        plotter.subplot(0, 0)
     plotter.add_text(f"{out.name}: step {chosen}, {label}", font_size=12)
     target = path or out / f"render_step_{chosen:04d}_{field}.png"
     target.parent.mkdir(parents=True, exist_ok=True)
     plotter.screenshot(str(target))
     plotter.close()
-    return target
+    return target, picture
 
 
-__all__ = ["render_step"]
+__all__ = ["draw_step", "render_step"]
