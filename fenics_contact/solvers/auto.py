@@ -17,7 +17,11 @@ This strategy
    continuation (factor ``continuation_factor`` a rung), warm-starting each
    rung from the last;
 2. runs each rung as plain GNRM (identical iterates to ``gnrm`` when the
-   user's r is inside the window); if that fails it restarts the rung with
+   user's r is inside the window); with the nodal rule, if that fails it
+   restarts the rung with plain GNRM at working r lowered by
+   ``continuation_factor`` (down to the window's bottom), and the r that
+   converges caps the working r of the later solves (the window follows
+   what was measured on the problem); if that fails too it restarts it with
    a line-searched GNRM (backtracking on the residual norm, non-monotone
    over the last three residuals), with friction retried with r_t halved
    when that cycles, and if that fails too it warm-starts
@@ -63,8 +67,14 @@ class AutoSettings:
     """Knobs of the automatic strategy.
 
     Attributes:
-        r_window: (low, high) range of the working r, relative to E/h.
-        continuation_factor: r ratio between continuation rungs (Gauss rule).
+        r_window: (low, high) range of the working r, relative to E/h (nodal
+            rule). Measured on the two cylinders (node-to-segment, 10 steps):
+            plain GNRM takes 30 Newton iterations at r <= 1 E/h and 89 at
+            1e2 E/h (a step cycles for 38 iterations), so the top is 1 E/h.
+        gauss_start: highest r (relative to E/h) at which the Gauss-rule
+            continuation starts (its answer depends on r; fewer rungs from higher).
+        continuation_factor: r ratio between continuation rungs (Gauss rule), and
+            the factor by which the working r is lowered after a failure (nodal rule).
         min_damping: smallest line-search step length tried.
         armijo: sufficient-decrease constant of the line search.
         nonmonotone: residuals the line search compares against (their max).
@@ -73,7 +83,8 @@ class AutoSettings:
             the iteration limit, before the penalty warm start.
     """
 
-    r_window: tuple[float, float] = (1e-2, 1e2)
+    r_window: tuple[float, float] = (1e-2, 1.0)
+    gauss_start: float = 1e2
     continuation_factor: float = 100.0
     min_damping: float = 1.0 / 64.0
     armijo: float = 1e-4
@@ -112,10 +123,23 @@ class AutoStrategy(NewtonStrategy):
         """Solve at the problem's current load; the problem's r is left unchanged."""
         return timed(self._solve)
 
+    #: The highest working r (relative to E/h) at which plain GNRM has not failed in
+    #: this problem: the window's top until a failure there lowers it (nodal rule).
+    _r_cap: float | None = None
+
     def working_r(self) -> float:
-        """The user's r clamped to the window (absolute, stress per length)."""
+        """The user's r clamped to the window (absolute, stress per length).
+
+        With the nodal rule the top of the window follows what was measured:
+        once plain GNRM failed at a working r and succeeded at a lower one
+        (:meth:`_lower_r`), later solves start at the lower one.
+        """
         scale = self.problem.stiffness_scale
         low, high = (w * scale for w in self.tuning.r_window)
+        if not self.problem.nodal_rule:
+            high = max(high, self.tuning.gauss_start * scale)
+        elif self._r_cap is not None:
+            high = min(high, self._r_cap * scale)
         return min(max(self.problem.r_absolute, low), high)
 
     def rungs(self) -> list[float]:
@@ -144,10 +168,10 @@ class AutoStrategy(NewtonStrategy):
                 )
             for r in rungs:
                 p.rescale_r(r)
-                status = self._rung(tally, self._stage_settings(r_user))
+                status = self._rung(tally, r_user)
                 if status is not Status.CONVERGED:
                     break
-            if status is Status.CONVERGED and rungs[-1] != r_user:
+            if status is Status.CONVERGED and p.r_absolute != r_user:
                 self._check_user_r(r_user, tally)
         finally:
             p.rescale_r(r_user)
@@ -156,13 +180,19 @@ class AutoStrategy(NewtonStrategy):
             tally.residuals, switches=tally.switches,
         )
 
-    def _rung(self, tally: _Tally, settings: SolverSettings) -> Status:
-        """Solve at the current r: GNRM, then line search, then penalty warm start."""
+    def _rung(self, tally: _Tally, r_user: float) -> Status:
+        """Solve at the current r: GNRM (at lower working r too), line search, penalty start."""
         p = self.problem
         saved = p.snapshot()
+        settings = self._stage_settings(r_user)
         status = self._newton(settings, tally, line_search=False)
         if status is Status.CONVERGED:
             return status
+        if p.nodal_rule:
+            status = self._lower_r(saved, tally, r_user, status)
+            if status is Status.CONVERGED:
+                return status
+            settings = self._stage_settings(r_user)
         tally.switches.append(f"gnrm {status.value} at r = {p.r_absolute:.3g}: line search")
         self._restore(saved)
         status = self._newton(settings, tally, line_search=True)
@@ -178,6 +208,32 @@ class AutoStrategy(NewtonStrategy):
             tally.switches.append("penalty warm start failed")
             self._restore(saved)
         return self._newton(settings, tally, line_search=True)
+
+    def _lower_r(self, saved: ProblemState, tally: _Tally, r_user: float,
+                 status: Status) -> Status:
+        """Nodal rule: plain GNRM again from the rung's start at a lower working r.
+
+        r is lowered by the continuation factor, down to the window's bottom; the r
+        that converges becomes the top of the window for later solves. Ends at the
+        lowest r tried when none converges.
+        """
+        p = self.problem
+        scale = p.stiffness_scale
+        low = self.tuning.r_window[0] * scale
+        while p.r_absolute > low * (1 + 1e-12):
+            r_failed = p.r_absolute
+            r_next = max(r_failed / self.tuning.continuation_factor, low)
+            tally.switches.append(
+                f"gnrm {status.value} at r = {r_failed:.3g}: lower the working r to "
+                f"{r_next:.3g} ({r_next / scale:.3g} E/h)"
+            )
+            self._restore(saved)
+            p.rescale_r(r_next)
+            status = self._newton(self._stage_settings(r_user), tally, line_search=False)
+            if status is Status.CONVERGED:
+                self._r_cap = r_next / scale
+                return status
+        return status
 
     def _check_user_r(self, r_user: float, tally: _Tally) -> None:
         """Nodal rule: evaluate the residual at the user's r against its floor."""
