@@ -134,7 +134,7 @@ direct, iterative = runs["direct"], runs["iterative"]
 say(f"displacement dofs {direct['displacement_dofs']}, multiplier dofs {direct['multiplier_dofs']}")
 say(f"{'solver':<10} {'Newton per step':<24} {'force':>10} {'active':>6} {'wall s':>7}")
 for kind, run in runs.items():
-    say(f"{kind:<10} {str(run['iterations_per_step']):<24} {run['contact_force']:>10.6f} "
+    say(f"{kind:<10} {run['iterations_per_step']!s:<24} {run['contact_force']:>10.6f} "
         f"{run['active_nodes']:>6} {run['wall_s']:>7.2f}")
 force_difference = abs(iterative["contact_force"] / direct["contact_force"] - 1)
 say(f"relative force difference {force_difference:.1e}; "
