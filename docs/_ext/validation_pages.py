@@ -36,9 +36,12 @@ def cell(value: object) -> str:
 
 
 def markdown_table(header: list[str], rows: list[list[object]]) -> str:
-    """A Markdown (pipe) table."""
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(cell(v) for v in row) + " |" for row in rows]
+    """A Markdown (pipe) table; pipes inside cells escaped."""
+    def line(cells: list[str]) -> str:
+        return "| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |"
+
+    lines = [line(header), "|" + "---|" * len(header)]
+    lines += [line([cell(v) for v in row]) for row in rows]
     return "\n".join(lines)
 
 
