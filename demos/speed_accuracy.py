@@ -134,9 +134,11 @@ say(f"\nWrote {args.out}/summary.json and pareto.png")
 # ## How to pick
 #
 # - For the exact contact conditions with no tuning, use `auto` (any r) or
-#   GNRM with r between $10^{-2}$ and $10^2\,E/h$: the same answer to
-#   round-off at every r, in the fewest iterations; GNRM points sit on the
-#   front's accurate end.
+#   GNRM: on this scene both take the same Newton iterations at every r of
+#   the sweep and reach the same answer to round-off, so one of them holds
+#   the accurate end of each mesh's front. On harder scenes GNRM's window is
+#   narrower; r between $10^{-2}$ and $10^2\,E/h$ is the safe middle
+#   (see the trade-off and stability page).
 # - The penalty method is fast only where its error is large: its
 #   displacement error falls like $1/r$, and at large r it costs as many
 #   iterations as GNRM for a worse answer. Against Hertz it can land near
