@@ -145,7 +145,8 @@ say(f"\nWrote {args.out}/summary.json and pareto.png")
 #   the discretisation error (its own error and the mesh's partly cancel);
 #   the displacement panel shows that it is not the discrete answer. Use it
 #   for a quick, approximate look.
-# - Nested Uzawa reaches the exact answer but needs many more Newton solves
-#   at small r; it is never on the front.
+# - Nested Uzawa reaches the exact answer from r = 1 E/h on, with many more
+#   Newton solves than GNRM at small r (it stops at the iteration limit
+#   below r = 1 E/h); it is never on the front.
 # - On a finer mesh every method costs more and the Hertz error shrinks:
 #   past the solver's own error, accuracy is bought with the mesh.
