@@ -22,6 +22,7 @@ extensions = [
     "scene_reference",
     "demo_notebooks",
     "api_pages",
+    "validation_pages",
 ]
 
 # .rst first: autosummary writes its module pages (reStructuredText) with the first suffix.

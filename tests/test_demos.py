@@ -132,3 +132,100 @@ def test_hertz_ufl_demo_shows_the_formulation():
         "hertz_line_contact(",
     ]:
         assert snippet in code, snippet
+
+
+def run_ci_demo(name, tmp_path, monkeypatch):
+    """Run a demo at its CI size into a folder every rank shares; its summary."""
+    monkeypatch.setenv("CI", "1")
+    out = shared_tmp(tmp_path)
+    run_demo(name, out, monkeypatch)
+    MPI.COMM_WORLD.Barrier()
+    return out, json.loads((out / "summary.json").read_text())
+
+
+@pytest.mark.mpi
+def test_paper_comparison_demo_gives_the_paper_table(tmp_path, monkeypatch):
+    """PM converges to a penalised answer, SUA fails, NUA needs many solves, GNRM 40-42."""
+    out, summary = run_ci_demo("paper_comparison.py", tmp_path, monkeypatch)
+    runs = {(run["method"], run["r"]): run for run in summary["runs"]}
+    assert summary["r_values"] == [1.0, 100.0, 10000.0]
+    assert [runs[("gnrm", r)]["iterations"] for r in (1.0, 100.0, 10000.0)] == [40, 40, 42]
+    assert all(runs[("gnrm", r)]["error"] < 1e-12 for r in (1.0, 100.0, 10000.0))
+    # the penalty error falls with r but never to round-off
+    errors = [runs[("penalty", r)]["error"] for r in (1.0, 100.0, 10000.0)]
+    assert errors[0] > errors[1] > errors[2] > 1e-4
+    assert all(runs[("sua", r)]["status"] != "converged" for r in (1.0, 100.0, 10000.0))
+    assert runs[("nua", 100.0)]["status"] == "converged"
+    assert runs[("nua", 100.0)]["iterations"] > 5 * runs[("gnrm", 100.0)]["iterations"]
+    assert runs[("nua", 10000.0)]["error"] < 1e-10
+    assert "| GNRM | 40 | 40 | 42 |" in (out / "table.md").read_text()
+    assert (out / "residuals.png").stat().st_size > 10_000
+
+
+@pytest.mark.mpi
+def test_two_cylinders_demo_follows_hertz_with_both_pairs(tmp_path, monkeypatch):
+    out, summary = run_ci_demo("two_cylinders.py", tmp_path, monkeypatch)
+    assert summary["mpi_ranks"] == MPI.COMM_WORLD.size
+    nts, mortar = summary["runs"]["node-to-segment"], summary["runs"]["mortar"]
+    for run in (nts, mortar):
+        assert run["h_contact"] == 0.01
+        assert len(run["iterations_per_step"]) == 10 and max(run["iterations_per_step"]) <= 6
+        assert abs(run["p0_error"]) < 0.01  # the fitted peak against Hertz
+        kkt = run["signorini"]
+        assert kkt["max_pressure"] <= 0.0 and kkt["max_complementarity"] < 1e-8
+    assert abs(nts["a_error"]) < 0.01 and abs(mortar["a_error"]) < 0.03
+    # on non-matching arcs mortar's largest nodal pressure is the closer one
+    assert abs(mortar["p0_nodal_error"]) < 0.01 < abs(nts["p0_nodal_error"]) < 0.04
+    assert mortar["P"] == pytest.approx(nts["P"], rel=2e-3)
+    assert (out / "pressure.png").stat().st_size > 10_000
+
+
+@pytest.mark.mpi
+def test_cattaneo_mindlin_demo_stick_zone_matches_theory(tmp_path, monkeypatch):
+    out, summary = run_ci_demo("cattaneo_mindlin.py", tmp_path, monkeypatch)
+    assert summary["mesh"]["h_contact"] == 0.005 and summary["mu"] == 0.3
+    assert max(summary["iterations_per_step"]) <= 10
+    zones = summary["zones"]
+    assert len(zones) == 9
+    ratios = [z["load_ratio"] for z in zones]
+    assert ratios == sorted(ratios) and 0.85 < ratios[-1] < 0.9
+    for z in zones:  # the stick edge to within its node spacing
+        assert abs(z["c_error"]) <= z["c_resolution"] + 0.005
+    assert [z["stick_nodes"] for z in zones] == sorted(
+        (z["stick_nodes"] for z in zones), reverse=True)
+    assert max(z["traction_error"] for z in zones[3:]) < 0.08
+    assert (out / "stick_zone.png").stat().st_size > 10_000
+
+
+def test_speed_accuracy_demo_marks_gnrm_exact_and_penalty_approximate(tmp_path, monkeypatch):
+    out, summary = run_ci_demo("speed_accuracy.py", tmp_path, monkeypatch)
+    rows = summary["records"]
+    assert {row["mesh"] for row in rows} == {"h=0.02", "h=0.01"}
+    for row in rows:
+        if row["method"] in ("gnrm", "auto"):
+            assert row["status"] == "converged" and row["u_error"] < 1e-12
+    for mesh in ("h=0.02", "h=0.01"):
+        gnrm = [row for row in rows if row["mesh"] == mesh and row["method"] == "gnrm"]
+        assert len({row["iterations"] for row in gnrm}) == 1  # the same at every r
+        penalty = sorted((row for row in rows if row["mesh"] == mesh
+                          and row["method"] == "penalty"), key=lambda row: row["r_relative"])
+        assert [row["u_error"] for row in penalty] == sorted(
+            (row["u_error"] for row in penalty), reverse=True)
+        assert penalty[-1]["u_error"] > 1e-8
+    assert any(row["pareto_u"] and row["method"] in ("gnrm", "auto") for row in rows)
+    assert (out / "pareto.png").stat().st_size > 10_000
+
+
+@pytest.mark.mpi
+def test_block_3d_demo_iterative_solver_equals_direct(tmp_path, monkeypatch):
+    out, summary = run_ci_demo("block_3d_iterative.py", tmp_path, monkeypatch)
+    assert summary["mpi_ranks"] == MPI.COMM_WORLD.size
+    direct, iterative = summary["runs"]["direct"], summary["runs"]["iterative"]
+    assert iterative["iterations_per_step"] == direct["iterations_per_step"]
+    assert max(direct["iterations_per_step"]) <= 5
+    assert summary["force_difference"] < 1e-10
+    assert iterative["active_nodes"] == direct["active_nodes"] > 0
+    kkt = iterative["signorini"]
+    assert kkt["min_gap"] > -1e-10 and kkt["max_pressure"] <= 0.0
+    assert kkt["max_complementarity"] < 1e-10
+    assert (out / "residuals.png").stat().st_size > 10_000

@@ -1,4 +1,4 @@
-"""The package's layers, as the README states them: no module imports a layer above its own.
+"""The package's layers, as docs/layout.md states them: no module imports a layer above its own.
 
 Every ``import`` and ``from ... import`` of every module is read with ``ast``
 (those inside functions and ``TYPE_CHECKING`` blocks too: a lazy import is
@@ -12,7 +12,7 @@ import pytest
 
 PACKAGE = Path(__file__).parent.parent / "fenics_contact"
 
-#: What each layer may import besides itself (the README's "What may import what").
+#: What each layer may import besides itself (docs/layout.md, "What may import what").
 #: Layers not named here (cli, runner, the package's top-level modules) may import
 #: anything.
 ALLOWED = {

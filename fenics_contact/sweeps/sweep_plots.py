@@ -12,6 +12,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import ListedColormap
+from matplotlib.ticker import NullFormatter
 
 from fenics_contact.output.plotting import save_figure
 from fenics_contact.solvers import PAPER_NAMES
@@ -60,6 +61,7 @@ def _panel(ax: plt.Axes, recs: Sequence[TradeoffRecord], field: str, front: str)
     for k, mesh in enumerate(meshes):
         ax.plot([], [], MARKERS[k % len(MARKERS)], color="grey", label=f"mesh {mesh}")
     ax.plot([], [], "o", mfc="none", mec="k", ms=10, label="Pareto front")
+    ax.xaxis.set_minor_formatter(NullFormatter())  # decade labels only: no overlap
     ax.set_xlabel("wall time, whole load path (s, median)")
     ax.legend(fontsize=7, ncol=2)
 

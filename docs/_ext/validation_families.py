@@ -1,0 +1,157 @@
+"""The validation families: per benchmark JSON, its table, its figure and how to read it.
+
+Each :class:`Family` turns the JSON a ``benchmarks/validation/<name>.py``
+script wrote into table rows and a matplotlib figure; ``FAMILIES`` maps the
+script's name to its family. Adding a family: a JSON in ``docs/data/``, a
+``Family`` here, and a line in ``docs/index.md``'s Validation toctree.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.figure import Figure
+
+Rows = tuple[list[str], list[list[object]]]
+
+
+@dataclass(frozen=True)
+class Family:
+    """One benchmark family's page: title, table, figure and a reading of them."""
+
+    title: str
+    table: Callable[[dict], Rows]
+    figure: Callable[[dict], Figure]
+    reading: str
+
+
+def _hertz2d_table(data: dict) -> Rows:
+    header = ["r / (E/h)", "predictor", "Newton", "per step", "P", "p0 nodal vs Hertz",
+              "a fit vs Hertz", "max penetration", "solve s"]
+    rows = [[r["r_relative"], r["predictor"], r["newton_total"], r["newton_per_step"],
+             r["force_P"], r["p0_nodal_error"], r["a_error"], r["max_penetration"],
+             r["total_s"]] for r in data["records"]]
+    return header, rows
+
+
+def _hertz2d_figure(data: dict) -> Figure:
+    records = [r for r in data["records"] if r["predictor"] == "extrapolate"]
+    fig, (left, right) = plt.subplots(1, 2, figsize=(10, 3.6))
+    rs = [r["r_relative"] for r in records]
+    left.semilogx(rs, [r["newton_total"] for r in records], "o-")
+    left.set_ylim(0, max(r["newton_total"] for r in records) * 1.3)
+    left.set_xlabel("r / (E/h)")
+    left.set_ylabel("Newton iterations, 10 steps")
+    left.set_title("GNRM: the same count at every r")
+    right.semilogx(rs, [100 * r["p0_nodal_error"] for r in records], "s-", label="peak (nodal)")
+    right.semilogx(rs, [100 * r["a_error"] for r in records], "o-", label="half-width (fit)")
+    right.axhline(0, color="k", lw=0.6)
+    right.set_xlabel("r / (E/h)")
+    right.set_ylabel("error against Hertz (%)")
+    right.legend(fontsize=8)
+    fig.tight_layout()
+    return fig
+
+
+def _hertz3d_table(data: dict) -> Rows:
+    header = ["h", "law", "status", "u DOFs", "Newton per step", "P", "a fit vs Hertz",
+              "p0 fit vs Hertz", "p0 nodal vs Hertz", "nodes in contact"]
+    rows = [[r["h_contact"], r["law"], r["status"], r["u_dofs"], r["newton_per_step"], r["P"],
+             r["a_error"], r["p0_fit_error"], r["p0_nodal_error"], r["n_contact"]]
+            for r in data["records"]]
+    return header, rows
+
+
+def _hertz3d_figure(data: dict) -> Figure:
+    fig, ax = plt.subplots(figsize=(6, 3.8))
+    for law, marker in (("linear", "o"), ("neo-hookean", "s")):
+        recs = sorted((r for r in data["records"] if r["law"] == law), key=lambda r: r["h_contact"])
+        h = [r["h_contact"] for r in recs]
+        ax.semilogx(h, [100 * r["a_error"] for r in recs], marker + "-", label=f"{law}: a")
+        ax.semilogx(h, [100 * r["p0_fit_error"] for r in recs], marker + "--",
+                    label=f"{law}: p0 (fit)")
+    ax.axhline(0, color="k", lw=0.6)
+    ax.set_xlabel("contact element size h / R")
+    ax.set_ylabel("error against Hertz (%)")
+    ax.set_title("Sphere octant on a rigid plane")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig
+
+
+def _mortar_table(data: dict) -> Rows:
+    header = ["h", "pair", "status", "Newton", "largest nodal p vs p0", "L2 |x| < 1.5 a",
+              "L2 |x| < a - 2h"]
+    rows = [[r["h"], r["discretisation"], r["status"], r["iterations"], r["peak_error"],
+             r["l2_whole"], r["l2_inside"]] for r in data["runs"]]
+    return header, rows
+
+
+def _mortar_figure(data: dict) -> Figure:
+    fig, (left, right) = plt.subplots(1, 2, figsize=(10, 3.6))
+    for kind, marker in (("node-to-segment", "s"), ("mortar", "o")):
+        runs = sorted((r for r in data["runs"] if r["discretisation"] == kind),
+                      key=lambda r: r["h"])
+        h = [r["h"] for r in runs]
+        left.loglog(h, [abs(r["peak_error"]) for r in runs], marker + "-", label=kind)
+        right.loglog(h, [r["l2_inside"] for r in runs], marker + "-", label=kind)
+    left.set_ylabel("|largest nodal pressure / p0 - 1|")
+    right.set_ylabel("relative L2 error, |x| < a - 2h")
+    for ax in (left, right):
+        ax.set_xlabel("contact element size h / R")
+        ax.legend(fontsize=8)
+    fig.suptitle("Two cylinders on non-matching meshes against Hertz")
+    fig.tight_layout()
+    return fig
+
+
+def _cattaneo_table(data: dict) -> Rows:
+    header = ["mesh", "Q/(mu P)", "c/a measured", "c/a analytic", "c error",
+              "half node spacing / c", "traction L2 error"]
+    rows = [[r["case"], r["load_ratio"], r["c_over_a"], r["c_over_a_analytic"], r["c_error"],
+             r["c_resolution"], r["traction_error"]] for r in data["records"]]
+    return header, rows
+
+
+def _cattaneo_figure(data: dict) -> Figure:
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ratio = np.linspace(0.0, 1.0, 200)
+    ax.plot(ratio, np.sqrt(1.0 - ratio), "k-", label="Cattaneo-Mindlin")
+    cases = list(dict.fromkeys(r["case"] for r in data["records"]))
+    for case, marker in zip(cases, ("o", "s", "^", "D"), strict=False):
+        recs = [r for r in data["records"] if r["case"] == case]
+        ax.plot([r["load_ratio"] for r in recs], [r["c_over_a"] for r in recs], marker,
+                mfc="none", label=case)
+    ax.set_xlabel("Q / (mu P)")
+    ax.set_ylabel("stick half-width c / a")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig
+
+
+FAMILIES: dict[str, Family] = {
+    "hertz2d": Family(
+        "Hertz line contact (2D)", _hertz2d_table, _hertz2d_figure,
+        "GNRM takes the same Newton iterations at every r; the answer, and so its "
+        "error against Hertz, does not depend on r (nodal rule).",
+    ),
+    "hertz3d": Family(
+        "Hertz point contact (3D)", _hertz3d_table, _hertz3d_figure,
+        "The contact radius and the peak pressure approach Hertz as the mesh is refined, "
+        "for the small-strain and the neo-Hookean law.",
+    ),
+    "mortar_hertz": Family(
+        "Two cylinders: mortar and node-to-segment pairs", _mortar_table, _mortar_figure,
+        "On non-matching meshes the one-pass node-to-segment pressures scatter node to "
+        "node and their error does not fall with h; inside the zone the mortar pair's "
+        "error falls with h (the whole-zone L2 error also holds the edge of the zone).",
+    ),
+    "cattaneo_mindlin": Family(
+        "Cattaneo-Mindlin partial slip", _cattaneo_table, _cattaneo_figure,
+        "The measured stick half-width is the midpoint between the last sticking and the "
+        "first slipping node: its error is to be read against the half node spacing.",
+    ),
+}
