@@ -78,12 +78,15 @@ def run(mu: float | None, coarse: bool, indenter_E: float | None = None) -> dict
             scene.mesh, parameters={"h_indenter": 0.08, "h_block": 0.12}))
     problem, top, knots, strategy = setup(scene)
     rows: list[dict] = []
+    # the tangential force vector acts on the striker: the friction force on the
+    # indenter is its opposite when the indenter strikes, itself when the block does
+    on_indenter = -1.0 if pair.striker == "striker_arc" else 1.0
 
     def on_step(step) -> None:
         force = problem.reaction(top)
         state = problem.contact_state()
-        friction = (-problem.tangential_force_vector() if hasattr(problem, "lam_t")
-                    else np.zeros(2))
+        friction = (on_indenter * problem.tangential_force_vector()
+                    if hasattr(problem, "lam_t") else np.zeros(2))
         normal = -force - friction
         rows.append({
             "step": step.step, "load_factor": step.load_factor,
