@@ -1,0 +1,172 @@
+"""3D mortar segmentation: clipping, provenance of the corners, exact tiling, weighted gaps."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from fenics_contact.model.segments3d import (
+    EDGE_CROSSING,
+    STRIKER_VERTEX,
+    TARGET_VERTEX,
+    clip,
+    corner_from_provenance,
+    segment_pair,
+    segment_surfaces,
+    weighted_gaps,
+)
+
+RNG = np.random.default_rng(20261126)
+
+
+def _polygon_area(xy: np.ndarray) -> float:
+    x, y = xy[:, 0], xy[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+
+
+def _grid_overlap(tri: np.ndarray, n: int = 1200) -> float:
+    """Area of (projected triangle) n (reference triangle) by counting grid points."""
+    h = 1.0 / n
+    g = (np.arange(n) + 0.5) * h
+    X, Y = np.meshgrid(g, g)
+    inside_ref = X + Y <= 1.0
+    a, b, c = tri
+    def side(p, q):
+        return (q[0] - p[0]) * (Y - p[1]) - (q[1] - p[1]) * (X - p[0])
+    s1, s2, s3 = side(a, b), side(b, c), side(c, a)
+    inside_t = ((s1 >= 0) & (s2 >= 0) & (s3 >= 0)) | ((s1 <= 0) & (s2 <= 0) & (s3 <= 0))
+    return float(np.sum(inside_ref & inside_t)) * h * h
+
+
+def test_clipped_polygon_is_the_overlap_of_the_two_triangles() -> None:
+    for _ in range(40):
+        tri = RNG.uniform(-0.4, 1.2, size=(3, 2))
+        polygon = clip(tri)
+        area = _polygon_area(np.array([x for x, _ in polygon])) if len(polygon) >= 3 else 0.0
+        assert area >= -1e-15  # counter-clockwise
+        assert area == pytest.approx(_grid_overlap(tri), abs=3e-3)
+
+
+def test_known_overlaps_are_exact() -> None:
+    covering = np.array([[-1.0, -1.0], [3.0, -1.0], [-1.0, 3.0]])
+    assert _polygon_area(np.array([x for x, _ in clip(covering)])) == pytest.approx(0.5, 1e-14)
+    assert {p for _, p in clip(covering)} == {(STRIKER_VERTEX, k, -1) for k in range(3)}
+    inside = np.array([[0.1, 0.1], [0.3, 0.1], [0.1, 0.3]])
+    assert {p for _, p in clip(inside[::-1])} == {(TARGET_VERTEX, k, -1) for k in range(3)}
+    shifted = np.array([[0.5, -1.0], [2.0, -1.0], [0.5, 3.0]])  # covers xi_1 >= 0.5
+    polygon = clip(shifted)
+    assert _polygon_area(np.array([x for x, _ in polygon])) == pytest.approx(0.125, 1e-14)
+    assert sorted(p[0] for _, p in polygon) == [STRIKER_VERTEX, EDGE_CROSSING, EDGE_CROSSING]
+
+
+def _random_pair() -> tuple[np.ndarray, np.ndarray]:
+    """A striker triangle near z = 0 (normal up) and an overlapping target facing it."""
+    striker = np.array([[0.0, 0.0, 0.0], [1.0, 0.1, 0.05], [0.2, 0.9, -0.04]])
+    centre = RNG.uniform(0.1, 0.6, size=2)
+    angles = np.sort(RNG.uniform(0, 2 * np.pi, 3))[::-1]  # clockwise seen from above
+    radius = RNG.uniform(0.3, 0.8)
+    target = np.column_stack([centre[0] + radius * np.cos(angles),
+                              centre[1] + radius * np.sin(angles),
+                              0.02 + 0.05 * RNG.standard_normal(3)])
+    return striker, target
+
+
+def test_corners_are_rebuilt_from_their_provenance_and_follow_the_bodies() -> None:
+    """The formulas a UFL form would hold give the clipped corners, before and after a
+    small motion of all six vertices (the same combinatorics)."""
+    checked = 0
+    for _ in range(30):
+        striker, target = _random_pair()
+        pieces = segment_pair(striker, target)
+        for xi, provenance in pieces:
+            for corner, (kind, i, j) in zip(xi, provenance, strict=True):
+                rebuilt = corner_from_provenance(kind, (i, j), striker, target)
+                np.testing.assert_allclose(rebuilt, corner, atol=1e-12)
+                checked += 1
+        moved_s = striker + 1e-7 * RNG.standard_normal((3, 3))
+        moved_t = target + 1e-7 * RNG.standard_normal((3, 3))
+        moved = segment_pair(moved_s, moved_t)
+        if len(moved) != len(pieces):
+            continue
+        for (_, provenance), (xi_m, provenance_m) in zip(pieces, moved, strict=True):
+            if provenance != provenance_m:
+                continue
+            for corner_m, (kind, i, j) in zip(xi_m, provenance, strict=True):
+                rebuilt = corner_from_provenance(kind, (i, j), moved_s, moved_t)
+                np.testing.assert_allclose(rebuilt, corner_m, atol=1e-12)
+    assert checked > 100
+
+
+def _grid_surface(nx: int, ny: int, z: float, flip: bool, jitter: float = 0.0,
+                  tilt: tuple[float, float] = (0.0, 0.0)):
+    """Triangulated unit square at height z (+ tilt), normal up (or down when flipped)."""
+    x = np.linspace(0.0, 1.0, nx + 1)
+    y = np.linspace(0.0, 1.0, ny + 1)
+    X, Y = np.meshgrid(x, y, indexing="ij")
+    if jitter:
+        inner = (X > 0) & (X < 1) & (Y > 0) & (Y < 1)
+        X = X + inner * jitter / nx * RNG.uniform(-1, 1, X.shape)
+        Y = Y + inner * jitter / ny * RNG.uniform(-1, 1, Y.shape)
+    Z = z + tilt[0] * X + tilt[1] * Y
+    points = np.column_stack([X.ravel(), Y.ravel(), Z.ravel()])
+    node = np.arange(points.shape[0]).reshape(nx + 1, ny + 1)
+    cells = []
+    for i in range(nx):
+        for j in range(ny):
+            a, b, c, d = node[i, j], node[i + 1, j], node[i + 1, j + 1], node[i, j + 1]
+            cells += [(a, b, c), (a, c, d)]
+    cells = np.array(cells)
+    if flip:
+        cells = cells[:, ::-1]
+    tri = points[cells]
+    normal_z = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])[:, 2]
+    assert np.all(normal_z < 0 if flip else normal_z > 0)  # no triangle turned over
+    return points, cells
+
+
+def test_segments_tile_the_striker_surface_on_non_matching_meshes() -> None:
+    """Every piece of a striker covered by the target belongs to exactly one segment."""
+    ps, cs = _grid_surface(5, 4, 0.0, flip=False, jitter=0.15)
+    pt, ct = _grid_surface(7, 9, 0.01, flip=True, jitter=0.15)
+    striker, target = ps[cs], pt[ct]
+    segments = segment_surfaces(striker, target)
+    areas = 0.5 * np.linalg.norm(np.cross(striker[:, 1] - striker[:, 0],
+                                          striker[:, 2] - striker[:, 0]), axis=-1)
+    covered = np.zeros(len(cs))
+    np.add.at(covered, segments.striker, 2.0 * areas[segments.striker] * segments.xi_areas())
+    np.testing.assert_allclose(covered, areas, rtol=1e-12)
+    assert covered.sum() == pytest.approx(1.0, rel=1e-12)
+
+
+def test_weighted_gaps_are_exact_for_planes() -> None:
+    """Non-matching flat surfaces: g~_j = d A_j at a distance d; a tilted target plane gives
+    the integral of the hat function times the linear gap."""
+    ps, cs = _grid_surface(5, 4, 0.0, flip=False, jitter=0.15)
+    striker = ps[cs]
+    n = ps.shape[0]
+    areas = 0.5 * np.linalg.norm(np.cross(striker[:, 1] - striker[:, 0],
+                                          striker[:, 2] - striker[:, 0]), axis=-1)
+    lumped = np.zeros(n)
+    np.add.at(lumped, cs, np.repeat(areas[:, None] / 3.0, 3, axis=1))
+    for tilt in ((0.0, 0.0), (0.05, -0.03)):
+        pt, ct = _grid_surface(7, 9, 0.02, flip=True, jitter=0.15, tilt=tilt)
+        # the target reaches past the striker so that every striker point is covered
+        pt[:, :2] = 1.2 * (pt[:, :2] - 0.5) + 0.5
+        pt[:, 2] = 0.02 + tilt[0] * pt[:, 0] + tilt[1] * pt[:, 1]
+        target = pt[ct]
+        segments = segment_surfaces(striker, target)
+        gaps, weights = weighted_gaps(striker, target, cs, segments, n)
+        np.testing.assert_allclose(weights, lumped, rtol=1e-12)
+        nodal = 0.02 + tilt[0] * ps[:, 0] + tilt[1] * ps[:, 1]
+        exact = np.zeros(n)
+        for cell, area in zip(cs, areas, strict=True):
+            g = nodal[cell]
+            exact[cell] += area * (g + g.sum()) / 12.0  # int N_j g = A (2 g_j + g_k + g_l) / 12
+        np.testing.assert_allclose(gaps, exact, rtol=1e-12, atol=1e-15)
+
+
+def test_target_triangles_not_facing_the_striker_give_no_segment() -> None:
+    striker = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    same_way = striker + np.array([0.0, 0.0, 0.01])
+    assert segment_pair(striker, same_way) == []
+    assert len(segment_pair(striker, same_way[::-1])) >= 1
