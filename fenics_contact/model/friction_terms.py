@@ -113,6 +113,23 @@ class CoulombFriction:
             ufl.sqrt(ufl.dot(self.traction_t, self.traction_t)) * surface.ds,
             entity_maps=surface.entity_maps, jit_options=contact.jit_options,
         )
+        # The reported tangential traction of a multiplier strategy: the converged
+        # multiplier lam_t (= tau at convergence), free of the round-off r eps g that
+        # the Coulomb radius -mu min(lam + r g, 0) carries at a huge user r.
+        multiplier = ufl.elem_mult(mask, lam_t)
+        self._multiplier_forms = [
+            [nodal(multiplier[i]) for i in range(k)],
+            [nodal(-(self.tangents * multiplier)[i]) for i in range(gdim)],
+        ]
+        self._multiplier_force_forms = [
+            fem.form((self.tangents * multiplier)[i] * surface.ds,
+                     entity_maps=surface.entity_maps, jit_options=contact.jit_options)
+            for i in range(gdim)
+        ]
+        self._multiplier_mag_form = fem.form(
+            ufl.sqrt(ufl.dot(multiplier, multiplier)) * surface.ds,
+            entity_maps=surface.entity_maps, jit_options=contact.jit_options,
+        )
         self.symmetry_constraints = self._constrain_symmetry_planes()
 
     def _constrain_symmetry_planes(self) -> int:
@@ -217,14 +234,29 @@ class CoulombFriction:
         """lam_t <- the regularised-stick traction of the penalty method (its history)."""
         self.set_lam_t(self._nodal_components(self._pen_forms))
 
+    @property
+    def _reports_multipliers(self) -> bool:
+        """Whether the outputs read the multipliers (not the penalty method's tractions)."""
+        return bool(self.contact.multiplier_is_pressure)
+
+    def _pressure_and_radius(self) -> tuple[np.ndarray, np.ndarray]:
+        """Owned nodal pressure (<= 0) and Coulomb radius rho = -mu p (stress), as reported."""
+        if self._reports_multipliers:
+            rho_form = self.surface.nodal(self._rho_form)
+            lam = self.contact.lam.x.array[: rho_form.size].copy()
+            pressure = self.contact.nodal_pressure(lam)
+            return pressure, -float(self.mu.value) * pressure
+        return (self.surface.nodal(self.contact._pressure_form),
+                self.surface.nodal(self._rho_form))
+
     def node_states(self) -> np.ndarray:
         """Per owned node: 0 open (p_n = 0), 1 stick (|y| < rho), 2 slip."""
         y = self._nodal_components(self._y_forms)
-        rho = self.surface.nodal(self._rho_form)
+        pressure, rho = self._pressure_and_radius()
         eps = float(self.eps.value)
         norm = np.sqrt(np.sum(y**2, axis=1) + eps**2)
         state = np.full(rho.size, OPEN, dtype=np.int8)
-        active = self.surface.nodal(self.contact._pressure_form) < 0.0
+        active = pressure < 0.0
         state[active] = np.where(norm[active] < rho[active], STICK, SLIP)
         return state
 
@@ -234,14 +266,18 @@ class CoulombFriction:
         The tangential traction on the body -T tau (stress) and the slip
         increment T dg_t of the body relative to the obstacle or target (length).
         """
-        traction, slip = (self._nodal_components(forms) for forms in self._global_forms)
-        return traction, slip
+        traction_forms = (self._multiplier_forms[1] if self._reports_multipliers
+                          else self._global_forms[0])
+        return (self._nodal_components(traction_forms),
+                self._nodal_components(self._global_forms[1]))
 
     def tangential_force_vector(self) -> np.ndarray:
         """Global int T tau dA (force; per thickness in 2D): minus the friction on the body."""
         self.contact.refresh()
+        forms = (self._multiplier_force_forms if self._reports_multipliers
+                 else self._tforce_forms)
         return np.array([
-            self.comm.allreduce(fem.assemble_scalar(f), op=MPI.SUM) for f in self._tforce_forms
+            self.comm.allreduce(fem.assemble_scalar(f), op=MPI.SUM) for f in forms
         ])
 
     def with_friction(self, base: ContactState) -> FrictionalContactState:
@@ -249,15 +285,17 @@ class CoulombFriction:
         states = self.node_states()
         comm = self.comm
         normal = {f: getattr(base, f) for f in ContactState.__dataclass_fields__}
+        multipliers = self._reports_multipliers
         return FrictionalContactState(**{
             **normal,
-            "tangential_traction": self._nodal_components(self._tau_forms),
+            "tangential_traction": self._nodal_components(
+                self._multiplier_forms[0] if multipliers else self._tau_forms),
             "slip": self._nodal_components(self._slip_forms),
-            "coulomb_limit": self.surface.nodal(self._rho_form),
+            "coulomb_limit": self._pressure_and_radius()[1],
             "node_state": states,
             "tangential_force": float(np.linalg.norm(self.tangential_force_vector())),
-            "tangential_magnitude": comm.allreduce(
-                fem.assemble_scalar(self._tmag_form), op=MPI.SUM
+            "tangential_magnitude": comm.allreduce(fem.assemble_scalar(
+                self._multiplier_mag_form if multipliers else self._tmag_form), op=MPI.SUM
             ),
             "stick_count": comm.allreduce(int(np.sum(states == STICK)), op=MPI.SUM),
             "slip_count": comm.allreduce(int(np.sum(states == SLIP)), op=MPI.SUM),
