@@ -288,3 +288,28 @@ def test_surfaces_pressed_on_both_sides_are_laid_side_by_side():
     assert first.max() < second.min() or second.max() < first.min()
     depth = np.asarray(view.surface.points) @ view.normal
     assert np.ptp(depth[shown > 0]) < 1e-12  # both pressed faces in one plane facing the camera
+
+
+def test_2d_bodies_get_their_own_fill():
+    import pyvista
+
+    from fenics_contact.output.contact_view import BODY
+    from fenics_contact.output.pictures import BODY_FILLS, _body_style
+
+    grid = pyvista.ImageData(dimensions=(3, 3, 1)).cast_to_unstructured_grid()
+    assert _body_style(grid) == {"color": BODY_FILLS[0]}
+    grid.cell_data[BODY] = np.array([0.0, 0.0, 1.0, 1.0])
+    style = _body_style(grid)
+    assert style["scalars"] == BODY and style["cmap"] == list(BODY_FILLS[:2])
+    assert not style["show_scalar_bar"]
+
+
+def test_friction_profile_zooms_on_a_narrow_zone():
+    from fenics_contact.output.friction_plot import contact_window
+
+    s = np.linspace(-1.0, 3.0, 81)  # spacing 0.05
+    touching = (s > 1.0) & (s < 1.4)
+    lo, hi = contact_window(s, touching)
+    assert lo < s[touching].min() and hi > s[touching].max() and hi - lo < 1.0
+    assert contact_window(s, np.abs(s - 1.0) < 1.5) is None  # wide: the whole surface
+    assert contact_window(s, np.zeros_like(s, dtype=bool)) is None

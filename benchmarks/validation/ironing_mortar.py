@@ -40,6 +40,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 from mpi4py import MPI
 
 import fenics_contact  # noqa: F401  (before dolfinx)
+from benchmarks import harness
 from benchmarks.validation.ironing import order
 from fenics_contact.scene.build import build_mesh, build_two_body_problem, tagged_facets
 from fenics_contact.scene.schema import load_scene
@@ -160,7 +161,7 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=Path("results/bench"))
     parser.add_argument("--figure", type=Path, default=None)
     args = parser.parse_args()
-    record: dict = {"mesh": "coarse" if args.coarse else "shipped",
+    record: dict = {"machine": harness.machine(), "mesh": "coarse" if args.coarse else "shipped",
                     "striker": "indenter" if args.swap else "block"}
     record["node-to-segment"] = run("node-to-segment", args.coarse, args.nts_surface_tol,
                                     args.swap)

@@ -21,8 +21,10 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 from squeeze_frames import draw, squeeze
 
+from benchmarks import harness
 from fenics_contact.scene.schema import load_scene
 
 E, D, SQUEEZE = 6.0, 2.0, 0.3
@@ -48,6 +50,7 @@ def main() -> None:
         x, p = f.contacts["top"]
         width.append(2.0 * float(np.max(x[p < 0, 0], initial=0.0)))
     record = {
+        "machine": harness.machine(),
         "converged": path.converged, "iterations": [s.iterations for s in path.steps],
         "compression": c.tolist(), "force_per_length": force.tolist(),
         "lindley": lindley(c).tolist(), "ratio": (force / lindley(c)).tolist(),

@@ -23,8 +23,10 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 from squeeze_frames import draw, squeeze
 
+from benchmarks import harness
 from fenics_contact.scene.schema import load_scene
 
 WALL = 0.1
@@ -72,6 +74,7 @@ def main() -> None:
     rel = np.abs(np.array(c["top"][:n]) - np.array(f["top"][:n])) / np.array(f["top"][:n])
     before = (np.array(c["inner_active"][:n]) == 0) & (np.array(f["inner_active"][:n]) == 0)
     record = {
+        "machine": harness.machine(),
         **runs, "travel": travel,
         "before_touch_max_difference": float(rel[before].max()),
         "after_touch_max_difference": float(rel[~before].max()) if np.any(~before) else None,

@@ -15,13 +15,17 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import sys
 from pathlib import Path
 
 import numpy as np
 
 from mpi4py import MPI
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+
 import fenics_contact  # noqa: F401  (before dolfinx)
+from benchmarks import harness
 from fenics_contact.references.hertz import fit_contact_profile, hertz_line_contact
 from fenics_contact.runner import run_scene
 from fenics_contact.scene.schema import load_scene
@@ -53,7 +57,9 @@ def main() -> None:
     # two identical cylinders: R_eff = R/2, E* = E / (2 (1 - nu^2))
     hertz = hertz_line_contact(base["force"], 0.5, 100.0, 0.3)
     fit = fit_contact_profile(base["x"], base["p"])
+    order = np.argsort(base["x"])
     record = {
+        "machine": harness.machine(),
         "force": base["force"], "iterations": base["iterations"],
         "max_penetration": base["max_penetration"],
         "a_hertz": hertz.a, "a_fit": fit.a, "a_error": fit.a / hertz.a - 1,
@@ -65,6 +71,7 @@ def main() -> None:
                        "pressure_max_abs_diff": float(np.max(np.abs(run["p"] - base["p"])))}
             for r, run in runs.items()
         },
+        "profile": {"x": base["x"][order].tolist(), "p": base["p"][order].tolist()},
     }
     if MPI.COMM_WORLD.rank == 0:
         args.out.mkdir(parents=True, exist_ok=True)
@@ -75,7 +82,6 @@ def main() -> None:
         import matplotlib.pyplot as plt
 
         fig, ax = plt.subplots(figsize=(6, 4))
-        order = np.argsort(base["x"])
         xs = np.linspace(-1.3 * hertz.a, 1.3 * hertz.a, 400)
         ax.plot(xs, hertz.pressure(xs), "k-", label="Hertz, two cylinders")
         ax.plot(base["x"][order], -base["p"][order], "o", ms=4, label="nodes (striker side)")

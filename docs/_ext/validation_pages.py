@@ -53,10 +53,32 @@ def docstring(script: Path) -> str:
     return "".join(p if i % 2 else p.replace("<", "&lt;") for i, p in enumerate(pieces))
 
 
+#: Options that only say where a benchmark writes its files.
+WHERE = ("--out", "--image", "--picture", "--figure")
+
+
+def options(machine: dict) -> str:
+    """The options a run was given (``machine["argv"]``), its output paths left out."""
+    argv, kept = list(machine.get("argv", [])), []
+    while argv:
+        word = argv.pop(0)
+        if word.split("=")[0] in WHERE:
+            if "=" not in word and argv:
+                argv.pop(0)
+            continue
+        kept.append(word)
+    return " ".join(kept)
+
+
 def page(name: str, family: Family, data: dict, root: Path) -> str:
     """The Markdown of one validation page."""
     machine = data.get("machine", {})
     header, rows = family.table(data)
+    given = options(machine)
+    command = f"python benchmarks/validation/{name}.py {given} --out results/bench".replace(
+        "  ", " ")
+    ran = (f"with the options `{given}`" if given else "with its default options"
+           ) if "argv" in machine else ""
     return "\n\n".join([
         f"# {family.title}",
         docstring(root / "benchmarks" / "validation" / f"{name}.py"),
@@ -65,11 +87,11 @@ def page(name: str, family: Family, data: dict, root: Path) -> str:
         markdown_table(header, rows),
         family.reading,
         "## Where these numbers come from",
-        f"Run on `{machine.get('host', '?')}` ({machine.get('cpus', '?')} cores, Python "
+        f"Run {ran + ' ' if ran else ''}on `{machine.get('host', '?')}` "
+        f"({machine.get('cpus', '?')} cores, Python "
         f"{machine.get('python', '?')}) on {machine.get('date', '?')}; the table and the "
         f"figure are drawn from `docs/data/{name}.json` when the site is built. To measure "
-        f"again: `python benchmarks/validation/{name}.py --out results/bench` and copy "
-        f"`results/bench/{name}.json` to `docs/data/`.",
+        f"again: `{command}` and copy `results/bench/{name}.json` to `docs/data/`.",
     ]) + "\n"
 
 

@@ -6,7 +6,8 @@ abscissa is the reference coordinate along which the contact surface
 extends most (x for a horizontal plane, y for a vertical wall). The traction
 drawn is the tangential traction the partner puts on the body (its first
 tangential component in 2D, its magnitude in 3D) with the limits +-mu p;
-sticking nodes are drawn as filled dots, slipping nodes as crosses.
+sticking nodes are drawn as filled dots, slipping nodes as crosses. A
+contact zone spanning under half the surface is shown alone.
 """
 
 from __future__ import annotations
@@ -58,6 +59,24 @@ def friction_profile_data(problem: ContactProblem) -> dict[str, dict[str, np.nda
     return out if comm.rank == 0 else None
 
 
+def contact_window(s: np.ndarray, touching: np.ndarray) -> tuple[float, float] | None:
+    """Abscissa limits around the touching nodes when they span under half the surface.
+
+    The window holds the touching nodes and a quarter of their span (at
+    least one node spacing) on each side; None when nothing touches or the
+    zone is wide enough to read on the whole surface.
+    """
+    if not np.any(touching) or s.size < 2:
+        return None
+    lo, hi = float(s[touching].min()), float(s[touching].max())
+    whole = float(s.max() - s.min())
+    if hi - lo >= 0.5 * whole:
+        return None
+    spacing = float(np.median(np.diff(np.unique(s)))) if np.unique(s).size > 1 else 0.0
+    margin = max(0.25 * (hi - lo), 2.0 * spacing, 1e-3 * whole)
+    return lo - margin, hi + margin
+
+
 def friction_profile(problem: ContactProblem, path: Path, title: str = "") -> None:
     """Draw tangential traction and the Coulomb limit +-mu p along each frictional contact."""
     profiles = friction_profile_data(problem)
@@ -76,8 +95,12 @@ def friction_profile(problem: ContactProblem, path: Path, title: str = "") -> No
         slip = data["state"] == SLIP
         ax.plot(s[stick], data["traction"][stick], "o", color="#1f77b4", ms=4, label="stick")
         ax.plot(s[slip], data["traction"][slip], "x", color="#d62728", ms=5, label="slip")
+        window = contact_window(s, (data["limit"] > 0) | (data["state"] != 0))
+        if window is not None:
+            ax.set_xlim(*window)
         ax.set_xlabel(f"reference {data['axis']} along the contact surface"
-                      + (f" '{name}'" if len(profiles) > 1 else ""))
+                      + (f" '{name}'" if len(profiles) > 1 else "")
+                      + (" (its touching part)" if window is not None else ""))
         ax.set_ylabel("tangential traction on the body")
         ax.axhline(0.0, color="k", lw=0.4)
         ax.legend(fontsize=8)

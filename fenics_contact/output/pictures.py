@@ -213,6 +213,45 @@ def _pressure_style(grid) -> dict[str, object]:
                                 "position_x": 0.86, "position_y": 0.2, "height": 0.6}}
 
 
+#: Light fills of the bodies in 2D, one per body (the pressure colours the contact lines).
+BODY_FILLS = ("#e4e4e4", "#c9dbef", "#eedcc2", "#d2ebd2", "#e6d3ea")
+#: Screen fractions of a 2D panel kept free below (scalar bar, label) and above (title).
+BELOW, ABOVE = 0.17, 0.06
+
+
+def _body_style(grid) -> dict[str, object]:
+    """``add_mesh`` keywords of the 2D body fill: one light colour per body, told apart."""
+    if BODY not in grid.cell_data:
+        return {"color": BODY_FILLS[0]}
+    ids = np.asarray(grid.cell_data[BODY]).astype(int)
+    if np.unique(ids).size < 2:
+        return {"color": BODY_FILLS[0]}
+    fills = [BODY_FILLS[k % len(BODY_FILLS)] for k in range(int(ids.max()) + 1)]
+    return {"scalars": BODY, "preference": "cell", "cmap": fills, "n_colors": len(fills),
+            "clim": (-0.5, len(fills) - 0.5), "show_scalar_bar": False}
+
+
+def _frame(plotter, window: np.ndarray, aspect: float) -> None:
+    """Fit ``window`` (2 x 3 bounds) in a parallel 2D panel, clear of the bar and the title.
+
+    The window, padded by a tenth, fills the panel's width or the height
+    between the bottom :data:`BELOW` and the top :data:`ABOVE` of it.
+    """
+    pad = 0.1 * float(np.max(window[1] - window[0]))
+    lo, hi = window[0] - pad, window[1] + pad
+    plotter.reset_camera(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]))
+    usable = 1.0 - BELOW - ABOVE
+    scale = 0.5 * max((hi[1] - lo[1]) / usable, (hi[0] - lo[0]) / aspect)
+    camera = plotter.camera
+    camera.parallel_scale = scale
+    # move the view so that the window's centre sits in the middle of the free band
+    shift = (0.5 * (BELOW - ABOVE)) * 2.0 * scale
+    focal, position = np.array(camera.focal_point), np.array(camera.position)
+    middle = 0.5 * (lo[1] + hi[1])
+    focal[1], position[1] = middle - shift, middle - shift
+    camera.focal_point, camera.position = tuple(focal), tuple(position)
+
+
 def _plane_picture(problem: ContactProblem, grid):
     """2D: the bodies in grey, the pressed boundary coloured; a window on each small zone."""
     import pyvista
@@ -241,7 +280,7 @@ def _plane_picture(problem: ContactProblem, grid):
     picture = Picture()
     for column, (window, label) in enumerate(views):
         plotter.subplot(0, column)
-        plotter.add_mesh(grid.copy(), color="#e4e4e4", show_edges=True, edge_color="#9a9a9a")
+        plotter.add_mesh(grid.copy(), show_edges=True, edge_color="#9a9a9a", **_body_style(grid))
         if lines is not None and lines.n_cells:  # the pressed boundary, coloured
             plotter.add_mesh(lines.copy(), line_width=7 if column else 5, **style)
         if nodes.n_points:  # the pressed nodes, visible at any zoom
@@ -255,11 +294,7 @@ def _plane_picture(problem: ContactProblem, grid):
                              line_width=3)
         plotter.view_xy()
         plotter.camera.parallel_projection = True
-        pad = 0.1 * float(np.max(window[1] - window[0]))
-        lo, hi = window[0] - pad, window[1] + pad
-        plotter.reset_camera(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]))
-        aspect = width / (1 + len(zooms)) / 700  # the panel's width over its height
-        plotter.camera.parallel_scale = 0.5 * max(hi[1] - lo[1], (hi[0] - lo[0]) / aspect)
+        _frame(plotter, window, aspect=width / (1 + len(zooms)) / 700)
         if zooms:
             plotter.add_text(label, position="lower_left", font_size=10)
         picture.panels.append(label)
