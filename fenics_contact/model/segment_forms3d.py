@@ -1,0 +1,162 @@
+"""The 3D mortar weighted gaps as UFL forms on a mesh of segments.
+
+One DOLFINx cell per segment (:mod:`.segments3d`): disconnected reference
+triangles, all at the same place, so that the spatial coordinate of a cell
+*is* the reference coordinate eta of the segment. The mesh is made once
+with a fixed capacity; a search only refills its DG0 coefficients:
+
+* ``X``: reference positions of the segment's striker triangle (rows 0-2)
+  and target triangle (rows 3-5), shape (6, 3);
+* ``w``: their displacements, the *extended unknowns* (6, 3), selected from
+  the bodies' displacement by the search (condensed as in 2D);
+* ``provenance``: one-hot weights of each corner's kind and indices (3, 15).
+
+The corners (:func:`~.segments3d.corner_from_provenance`, written in UFL),
+the striker point, the gap along the striker normal and the hat functions
+N_j are UFL expressions of those, so ``ufl.derivative`` with respect to
+``w`` linearises the whole segmentation (normals, projections, edge
+crossings). Unused cells hold a dummy pair of triangles and zero weights:
+they contribute nothing. Assembling :attr:`SegmentForms.gap_form` gives,
+per cell, the three contributions int_seg N_j g dA of the segment to its
+striker corners (length^3); :attr:`weight_form` the int_seg N_j dA
+(length^2).
+
+Status: the forms, their assembly and their tangent are built and tested
+(``tests/test_segments3d.py``); joining them to the bodies' system
+(gathering to the striker nodes, the nodal Alart-Curnier terms and the
+chain rule of the tangent) is the next step (docs/two_bodies.md).
+"""
+
+from __future__ import annotations
+
+import basix.ufl
+import numpy as np
+import ufl
+from dolfinx import fem
+from dolfinx import mesh as dmesh
+
+from mpi4py import MPI
+
+from fenics_contact.model.segments3d import REFERENCE, STRIKER_EDGES, Segments
+
+#: Columns of a corner's provenance row: kind (3), striker corner (3), target
+#: vertex (3), striker edge (3), target edge (3).
+KIND, CORNER, VERTEX, EDGE, TARGET_EDGE = 0, 3, 6, 9, 12
+#: A pair of triangles that keeps every formula finite in unused cells.
+_DUMMY = np.vstack([np.column_stack([REFERENCE, np.zeros(3)]),
+                    np.column_stack([REFERENCE[::-1], np.ones(3)])])
+
+
+def provenance_weights(segments: Segments) -> np.ndarray:
+    """One-hot provenance rows of every segment corner, shape (k, 3, 15)."""
+    k = len(segments)
+    out = np.zeros((k, 3, 15))
+    rows = np.arange(k)
+    for c in range(3):
+        kind, i, j = segments.kind[:, c], segments.index[:, c, 0], segments.index[:, c, 1]
+        out[rows, c, KIND + kind] = 1.0
+        for code, column in ((0, CORNER), (1, VERTEX), (2, EDGE)):
+            sel = kind == code
+            out[rows[sel], c, column + i[sel]] = 1.0
+        sel = kind == 2
+        out[rows[sel], c, TARGET_EDGE + j[sel]] = 1.0
+    return out
+
+
+class SegmentForms:
+    """A segment mesh of ``capacity`` cells with the weighted-gap forms on it (one process).
+
+    Args:
+        capacity: the most segments it can hold.
+        comm: the mesh's communicator (each process segments its own striker triangles).
+    """
+
+    def __init__(self, capacity: int, comm: MPI.Comm = MPI.COMM_SELF) -> None:
+        self.capacity = int(capacity)
+        x = np.tile(REFERENCE, (self.capacity, 1))
+        cells = np.arange(3 * self.capacity, dtype=np.int64).reshape(-1, 3)
+        element = basix.ufl.element("Lagrange", "triangle", 1, shape=(2,))
+        self.mesh = dmesh.create_mesh(comm, cells, element, x)
+        #: Input row of each local cell (the mesh may reorder the cells).
+        self.cell_rows = np.asarray(self.mesh.topology.original_cell_index, dtype=np.int64)
+        self.W6 = fem.functionspace(self.mesh, ("DG", 0, (6, 3)))
+        self.X = fem.Function(self.W6, name="segment_vertices")
+        self.w = fem.Function(self.W6, name="segment_displacements")
+        self.provenance = fem.Function(fem.functionspace(self.mesh, ("DG", 0, (3, 15))))
+        self.V3 = fem.functionspace(self.mesh, ("DG", 0, (3,)))
+        self.count = 0
+        gap, jac, shape = self._integrand()
+        v = ufl.TestFunction(self.V3)
+        dx = ufl.dx(metadata={"quadrature_degree": 2})  # N_j g is quadratic on a segment
+        self.gap_form = ufl.dot(shape * gap * jac, v) * dx
+        self.weight_form = ufl.dot(shape * jac, v) * dx
+        self.fill(np.zeros((0, 6, 3)), np.zeros((0, 3, 15)))
+
+    def _integrand(self):
+        X, w, p = self.X, self.w, self.provenance
+
+        def point(r: int):
+            return ufl.as_vector([X[r, i] + w[r, i] for i in range(3)])
+
+        s = [point(r) for r in range(3)]
+        t = [point(r) for r in range(3, 6)]
+        e1, e2 = s[1] - s[0], s[2] - s[0]
+        n = ufl.cross(e1, e2)
+        det = ufl.dot(n, n)
+        m1, m2 = ufl.cross(e2, n) / det, ufl.cross(n, e1) / det
+        projected = [ufl.as_vector([ufl.dot(q - s[0], m1), ufl.dot(q - s[0], m2)]) for q in t]
+        reference = [ufl.as_vector([float(a), float(b)]) for a, b in REFERENCE]
+
+        def crossing(a, b, edge: int):
+            ca, cb, cc = (float(v) for v in STRIKER_EDGES[edge])
+            fa = ca * a[0] + cb * a[1] - cc
+            fb = ca * b[0] + cb * b[1] - cc
+            safe = fa - fb + ufl.conditional(ufl.eq(fa, fb), 1.0, 0.0)
+            return a + fa / safe * (b - a)
+
+        corners = []
+        for c in range(3):
+            fixed = sum(p[c, CORNER + k] * reference[k] for k in range(3))
+            vertex = sum(p[c, VERTEX + k] * projected[k] for k in range(3))
+            crossed = sum(p[c, EDGE + e] * p[c, TARGET_EDGE + k]
+                          * crossing(projected[k], projected[(k + 1) % 3], e)
+                          for e in range(3) for k in range(3))
+            corners.append(p[c, KIND] * fixed + p[c, KIND + 1] * vertex
+                           + p[c, KIND + 2] * crossed)
+        eta = ufl.SpatialCoordinate(self.mesh)
+        d1, d2 = corners[1] - corners[0], corners[2] - corners[0]
+        xi = corners[0] + d1 * eta[0] + d2 * eta[1]
+        shape = ufl.as_vector([1 - xi[0] - xi[1], xi[0], xi[1]])
+        x_s = shape[0] * s[0] + shape[1] * s[1] + shape[2] * s[2]
+        n_s = n / ufl.sqrt(det)
+        n_t = ufl.cross(t[1] - t[0], t[2] - t[0])
+        gap = ufl.dot(t[0] - x_s, n_t) / ufl.dot(n_s, n_t)
+        # int_seg f dA = |e1 x e2| |det(d1, d2)| int_cell f d(eta) (the cell's area is 1/2)
+        jac = abs(d1[0] * d2[1] - d1[1] * d2[0]) * ufl.sqrt(det)
+        return gap, jac, shape
+
+    def fill(self, vertices: np.ndarray, provenance: np.ndarray) -> None:
+        """Load k <= capacity segments: (k, 6, 3) reference vertices, (k, 3, 15) provenance.
+
+        The displacements ``w`` are set to zero; the remaining cells are emptied.
+        """
+        k = vertices.shape[0]
+        if k > self.capacity:
+            raise ValueError(f"{k} segments exceed the segment mesh's capacity "
+                             f"{self.capacity}; make it larger.")
+        allv = np.broadcast_to(_DUMMY, (self.capacity, 6, 3)).copy()
+        allp = np.zeros((self.capacity, 3, 15))
+        allv[:k], allp[:k] = vertices, provenance
+        self.X.x.array[:] = allv[self.cell_rows].reshape(-1)
+        self.provenance.x.array[:] = allp[self.cell_rows].reshape(-1)
+        self.w.x.array[:] = 0.0
+        self.count = k
+
+    def per_segment(self, assembled: np.ndarray) -> np.ndarray:
+        """Cell values of an assembled DG0 (3,) vector in segment order, shape (count, 3)."""
+        out = np.empty((self.capacity, 3))
+        out[self.cell_rows] = assembled.reshape(-1, 3)
+        return out[: self.count]
+
+
+__all__ = ["SegmentForms", "provenance_weights"]
