@@ -43,7 +43,6 @@ from fenics_contact.model.mortar import MortarContact
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings
 
-ROOT = Path(__file__).resolve().parents[2]
 STEPS = 10
 DISCRETISATIONS = ("node-to-segment", "mortar")
 ACCOUNTS = ("residual_s", "jacobian_s", "setup_s", "solve_s", "search_s", "transfer_s")
