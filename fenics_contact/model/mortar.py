@@ -265,7 +265,11 @@ class MortarTransfer:
 
 
 class MortarContact(Contact):
-    """A striker surface against a target surface of another body: 2D mortar.
+    """A striker surface against a target surface of another body: 2D or 3D mortar.
+
+    In 2D the nodal gap is a UFL expression of the node's stencil (this
+    module); in 3D it is an extra unknown-like coefficient G whose value,
+    derivative and curvature come from the segment forms (:mod:`.mortar3d`).
 
     Same interface as :class:`~.pairs.NodeToSegmentContact` (r relative to
     E/h with the pair modulus 2 E_s E_t / (E_s + E_t)); see the module for
@@ -300,13 +304,24 @@ class MortarContact(Contact):
     def _bind_partner(self, solid) -> ufl.core.expr.Expr:
         from fenics_contact.model.pairs import bind_pair_bodies
 
-        if solid.degree != 1 or solid.gdim != 2:
-            raise ValueError("Mortar contact needs degree = 1 and a 2D mesh in this version.")
+        if solid.degree != 1:
+            raise ValueError("Mortar contact needs degree = 1 (linear elements) in this version.")
         overlap = np.intersect1d(self.facets, self.target_facets).size
         if self.comm.allreduce(overlap, op=MPI.SUM):
             raise ValueError("The striker and target facet sets share facets; a contact pair "
                              "needs two disjoint surfaces (tag them separately).")
         bind_pair_bodies(self, solid)
+        if solid.gdim == 3:
+            from fenics_contact.model.mortar3d import MortarTransfer3D
+
+            if self.friction_settings is not None:
+                raise ValueError("Coulomb friction on 3D mortar pairs is not available in this "
+                                 "version; use discretisation = \"node-to-segment\" for a "
+                                 "frictional 3D pair.")
+            self.mortar = MortarTransfer3D(solid.V, solid.u, self.surface, self.target_facets,
+                                           self.surface.h)
+            self.mortar.refresh()
+            return self.mortar.G
         self.mortar = MortarTransfer(solid.V, solid.u, self.surface, self.target_facets,
                                      self._slots)
         X = ufl.SpatialCoordinate(solid.domain)
@@ -332,16 +347,18 @@ class MortarContact(Contact):
             self.mortar.set_previous()
 
     def extras(self) -> list[fem.Function]:
-        """The packed neighbour and slot displacements (condensed by w = S u)."""
-        return [self.mortar.w]
+        """2D: the packed neighbour and slot displacements (w = S u); 3D: the nodal gaps G."""
+        return [self.mortar.G] if self.gdim == 3 else [self.mortar.w]
 
     @property
-    def transfer(self) -> MortarTransfer:
-        """The slot search and selection (refresh, version, sources)."""
+    def transfer(self):
+        """The search and condensation (refresh, version, sources or condensation)."""
         return self.mortar
 
     def target_force(self) -> fem.Function:
         """Contact force on the target's vertices, S^T dL_c/dw over the slot rows (force)."""
+        if self.gdim == 3:
+            return self._target_force_3d()
         m = self.mortar
         if self._target_force_forms is None:
             q = ufl.TestFunction(m.W)
@@ -370,6 +387,24 @@ class MortarContact(Contact):
         out.x.array[: im.size_local * 2] = -vec.getArray(readonly=True)
         out.x.scatter_forward()
         vec.destroy()
+        return out
+
+
+    def _target_force_3d(self) -> fem.Function:
+        """-(dG/du)^T dL_c/dG on the target's vertices (force)."""
+        m = self.mortar
+        if self._target_force_forms is None:
+            form = ufl.derivative(self.lagrangian(), m.G, ufl.TestFunction(self.Q))
+            self._target_force_forms = [fem.form(form, entity_maps=self.surface.entity_maps)]
+        m.refresh()
+        local = fem.assemble_vector(self._target_force_forms[0])
+        local.scatter_reverse(la.InsertMode.add)
+        force = m.target_force(local.array[: m.n_owned])
+        V = self.solid.V
+        lo, hi = V.dofmap.index_map.local_range
+        out = fem.Function(V, name="target_contact_force")
+        out.x.array[: (hi - lo) * 3] = force[3 * lo : 3 * hi]
+        out.x.scatter_forward()
         return out
 
 

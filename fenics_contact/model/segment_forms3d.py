@@ -21,19 +21,22 @@ per cell, the three contributions int_seg N_j g dA of the segment to its
 striker corners (length^3); :attr:`weight_form` the int_seg N_j dA
 (length^2).
 
-Status: the forms, their assembly and their tangent are built and tested
-(``tests/test_segments3d.py``); joining them to the bodies' system
-(gathering to the striker nodes, the nodal Alart-Curnier terms and the
-chain rule of the tangent) is the next step (docs/two_bodies.md).
+For the chain rule of the nodal gaps (:mod:`.mortar3d`) the module also
+holds the derivatives of both with respect to ``w`` (per cell 3 x 18) and
+the second derivative (per cell 18 x 18) of the weighted sum
+sum_corners (a_c N_c g + b_c N_c) jac over the segment, with ``a`` and ``b``
+DG0 data (3,) per cell.
 """
 
 from __future__ import annotations
 
 import basix.ufl
 import numpy as np
+import scipy.sparse as sp
 import ufl
 from dolfinx import fem
 from dolfinx import mesh as dmesh
+from dolfinx.fem import petsc as fem_petsc
 
 from mpi4py import MPI
 
@@ -90,7 +93,61 @@ class SegmentForms:
         dx = ufl.dx(metadata={"quadrature_degree": 2})  # N_j g is quadratic on a segment
         self.gap_form = ufl.dot(shape * gap * jac, v) * dx
         self.weight_form = ufl.dot(shape * jac, v) * dx
+        #: Corner weights of the weighted gaps (a) and covered areas (b) in :attr:`hessian_form`.
+        self.a = fem.Function(self.V3, name="gap_weights")
+        self.b = fem.Function(self.V3, name="area_weights")
+        dw, dW = ufl.TestFunction(self.W6), ufl.TrialFunction(self.W6)
+        weighted = (ufl.dot(self.a, shape) * gap + ufl.dot(self.b, shape)) * jac * dx
+        self.gap_tangent_form = ufl.derivative(self.gap_form, self.w, dW)
+        self.weight_tangent_form = ufl.derivative(self.weight_form, self.w, dW)
+        self.hessian_form = ufl.derivative(ufl.derivative(weighted, self.w, dw), self.w, dW)
+        self._compiled: dict[str, fem.Form] | None = None
+        self._matrices: dict = {}
         self.fill(np.zeros((0, 6, 3)), np.zeros((0, 3, 15)))
+
+    def compiled(self) -> dict[str, fem.Form]:
+        """The five forms compiled (once; cheap C optimisation, the Hessian kernel is large)."""
+        if self._compiled is None:
+            options = {"cffi_extra_compile_args": ["-O1", "-g0"]}
+            self._compiled = {
+                name: fem.form(getattr(self, f"{name}_form"), jit_options=options)
+                for name in ("gap", "weight", "gap_tangent", "weight_tangent", "hessian")
+            }
+        return self._compiled
+
+    def assemble_matrix(self, name: str) -> sp.csr_matrix:
+        """A compiled bilinear form (``gap_tangent``, ``weight_tangent``, ``hessian``) as CSR.
+
+        The PETSc matrix is made once per form (its pattern is block diagonal, one
+        block per cell) and refilled.
+        """
+        form = self.compiled()[name]
+        matrix = self._matrices.get(name)
+        if matrix is None:
+            matrix = self._matrices[name] = fem_petsc.create_matrix(form)
+        matrix.zeroEntries()
+        fem_petsc.assemble_matrix(matrix, form)
+        matrix.assemble()
+        indptr, indices, data = matrix.getValuesCSR()
+        return sp.csr_matrix((data, indices, indptr), shape=matrix.getSize())
+
+    def cell_dofs(self) -> tuple[np.ndarray, np.ndarray]:
+        """Input row (segment) of every dof of the (3,) and the (6, 3) DG0 spaces.
+
+        Returns (rows3, rows18): for each local dof its segment row, and the
+        position inside the segment's block (corner c, or vertex row r * 3 + i).
+        """
+        out = []
+        for space in (self.V3, self.W6):
+            bs = space.dofmap.index_map_bs
+            block = space.dofmap.list.reshape(-1)  # one block per cell
+            row = np.empty(block.size * bs, np.int64)
+            pos = np.empty(block.size * bs, np.int64)
+            dofs = (block[:, None] * bs + np.arange(bs)[None, :])
+            row[dofs.reshape(-1)] = np.repeat(self.cell_rows, bs)
+            pos[dofs.reshape(-1)] = np.tile(np.arange(bs), block.size)
+            out.append((row, pos))
+        return out[0], out[1]
 
     def _integrand(self):
         X, w, p = self.X, self.w, self.provenance
@@ -151,6 +208,13 @@ class SegmentForms:
         self.provenance.x.array[:] = allp[self.cell_rows].reshape(-1)
         self.w.x.array[:] = 0.0
         self.count = k
+
+    def set_corner_weights(self, a: np.ndarray, b: np.ndarray) -> None:
+        """Load the (count, 3) corner weights of :attr:`hessian_form` (zero in unused cells)."""
+        for f, values in ((self.a, a), (self.b, b)):
+            full = np.zeros((self.capacity, 3))
+            full[: self.count] = values
+            f.x.array[:] = full[self.cell_rows].reshape(-1)
 
     def per_segment(self, assembled: np.ndarray) -> np.ndarray:
         """Cell values of an assembled DG0 (3,) vector in segment order, shape (count, 3)."""

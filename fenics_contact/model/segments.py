@@ -48,49 +48,58 @@ def node_blocks(V: fem.FunctionSpace) -> np.ndarray:
 
 
 class Polyline:
-    """A facet set of a 2D mesh gathered on every rank, oriented outward.
+    """A facet set gathered on every rank, oriented outward (2D segments or 3D triangles).
 
     Attributes:
-        blocks: (m, 2) global V blocks of each facet's vertices, ordered so
-            that perp(x_1 - x_0) points out of the body.
+        blocks: (m, d) global V blocks of each facet's vertices, ordered so
+            that the facet's normal points out of the body: perp(x_1 - x_0)
+            with perp(t) = (t_y, -t_x) in 2D, (x_1 - x_0) x (x_2 - x_0) in 3D.
         vertices: the distinct global blocks; ``facet_vertex`` indexes them.
-        X: (len(vertices), 2) reference positions of the vertices (length).
+        X: (len(vertices), d) reference positions of the vertices (length).
+        owned: (start, stop) of this rank's facets in ``blocks``.
     """
 
-    def __init__(self, V: fem.FunctionSpace, facets: np.ndarray) -> None:
+    def __init__(self, V: fem.FunctionSpace, facets: np.ndarray, *, dim: int = 2) -> None:
         domain = V.mesh
         comm = domain.comm
         tdim = domain.topology.dim
         fdim = tdim - 1
-        if domain.geometry.dim != 2:
-            raise ValueError("Mortar contact is 2D only in this version; use node-to-segment.")
+        gdim = domain.geometry.dim
+        if gdim != dim:
+            raise ValueError(f"This mortar surface is {dim}D; the mesh is {gdim}D.")
         for d0, d1 in ((fdim, tdim), (0, tdim), (tdim, 0), (fdim, 0)):
             domain.topology.create_connectivity(d0, d1)
         facets = np.unique(np.asarray(facets, np.int32))
         facets = facets[facets < domain.topology.index_map(fdim).size_local]
-        x = domain.geometry.x[:, :2]
+        x = domain.geometry.x[:, :gdim]
         if facets.size:
-            nodes = mesh.entities_to_geometry(domain, fdim, facets).reshape(-1, 2)
+            nodes = mesh.entities_to_geometry(domain, fdim, facets)
+            if nodes.shape[1] != gdim:
+                raise ValueError("Mortar facets must be segments (2D) or triangles (3D); "
+                                 "split quadrilateral faces into triangles.")
             f2c = domain.topology.connectivity(fdim, tdim)
             cells = np.array([f2c.links(f)[0] for f in facets], np.int64)
             centre = x[domain.geometry.dofmaps[0][cells]].mean(axis=1)
-            t = x[nodes[:, 1]] - x[nodes[:, 0]]
-            n = np.stack([t[:, 1], -t[:, 0]], axis=-1)
+            n = _facet_normals(x[nodes])
             flip = np.einsum("ij,ij->i", n, x[nodes].mean(axis=1) - centre) < 0
-            nodes[flip] = nodes[flip][:, ::-1]
+            nodes[flip] = nodes[flip][:, ::-1] if gdim == 2 else nodes[flip][:, [0, 2, 1]]
             local = node_blocks(V)[nodes].reshape(-1).astype(np.int32)
-            blocks = V.dofmap.index_map.local_to_global(local).reshape(-1, 2)
+            blocks = V.dofmap.index_map.local_to_global(local).reshape(-1, gdim)
             coords = x[nodes]
         else:
-            blocks, coords = np.zeros((0, 2), np.int64), np.zeros((0, 2, 2))
+            blocks, coords = np.zeros((0, gdim), np.int64), np.zeros((0, gdim, gdim))
+        counts = comm.allgather(int(blocks.shape[0]))
+        start = int(sum(counts[: comm.rank]))
+        self.owned = (start, start + counts[comm.rank])
         self.blocks = np.concatenate(comm.allgather(blocks.astype(np.int64)))
-        all_x = np.concatenate(comm.allgather(coords.reshape(-1, 2, 2)))
+        all_x = np.concatenate(comm.allgather(coords.reshape(-1, gdim, gdim)))
         if self.blocks.shape[0] == 0:
             raise ValueError("A mortar surface has no facets on any rank.")
+        self.dim = gdim
         self.vertices, inverse = np.unique(self.blocks, return_inverse=True)
-        self.facet_vertex = inverse.reshape(-1, 2)
-        self.X = np.zeros((self.vertices.size, 2))
-        self.X[self.facet_vertex.reshape(-1)] = all_x.reshape(-1, 2)
+        self.facet_vertex = inverse.reshape(-1, gdim)
+        self.X = np.zeros((self.vertices.size, gdim))
+        self.X[self.facet_vertex.reshape(-1)] = all_x.reshape(-1, gdim)
         lo, hi = V.dofmap.index_map.local_range
         mine = (self.vertices >= lo) & (self.vertices < hi)
         self._own_local = (self.vertices[mine] - lo).astype(np.int64)
@@ -99,9 +108,10 @@ class Polyline:
 
     def displacements(self, u: fem.Function) -> np.ndarray:
         """Displacement of every vertex, on every rank (collective)."""
-        values = u.x.array.reshape(-1, 2)[self._own_local]
-        out = np.empty((self.vertices.size, 2))
-        out[self._own_pos] = np.concatenate(self.comm.allgather(values.reshape(-1, 2)))
+        d = self.dim
+        values = u.x.array.reshape(-1, d)[self._own_local]
+        out = np.empty((self.vertices.size, d))
+        out[self._own_pos] = np.concatenate(self.comm.allgather(values.reshape(-1, d)))
         return out
 
     def index(self, blocks: np.ndarray) -> np.ndarray:
@@ -109,8 +119,16 @@ class Polyline:
         pos = np.searchsorted(self.vertices, blocks)
         pos = np.minimum(pos, self.vertices.size - 1)
         if not np.all(self.vertices[pos] == blocks):
-            raise ValueError("A striker node is not a vertex of the striker polyline.")
+            raise ValueError("A striker node is not a vertex of the striker surface.")
         return pos
+
+
+def _facet_normals(X: np.ndarray) -> np.ndarray:
+    """Unnormalised normals of facets (m, d, d) in their vertex order."""
+    if X.shape[-1] == 2:
+        t = X[:, 1] - X[:, 0]
+        return np.stack([t[:, 1], -t[:, 0]], axis=-1)
+    return np.cross(X[:, 1] - X[:, 0], X[:, 2] - X[:, 0])
 
 
 def neighbours(line: Polyline, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -50,6 +50,11 @@ STRIKER_EDGES = np.array([[0.0, 1.0, 0.0], [1.0, 1.0, 1.0], [1.0, 0.0, 0.0]])
 REFERENCE = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
 #: Polygons thinner than this (in xi area) are dropped.
 AREA_TOL = 1e-14
+#: A target vertex at most this far outside a striker edge (in xi) counts as inside: the
+#: crossing of two nearly collinear edges (the rims of two faces that end together) is
+#: ill-conditioned, and its derivative, large as 1 / distance, would swamp the tangent.
+#: The sliver so kept is at most this wide.
+CLIP_TOL = 1e-6
 #: Cosine of the largest angle between n_s and -n_t for a target triangle to count.
 OPPOSING = 0.2
 
@@ -140,16 +145,16 @@ def clip(target_xi: np.ndarray) -> list[tuple[np.ndarray, tuple[int, int, int]]]
             (p, prov_p), (q, _) = poly[v], poly[(v + 1) % count]
             line = lines[v]
             fp, fq = _inside(p, edge), _inside(q, edge)
-            if fp >= 0.0:
+            if fp >= -CLIP_TOL:
                 out.append((p, prov_p))
-                if fq >= 0.0:
+                if fq >= -CLIP_TOL:
                     out_lines.append(line)
                     continue
                 out_lines.append(line)
                 x = _crossing(p, q, edge)
                 out.append((x, _crossing_provenance(line, edge)))
                 out_lines.append(("s", edge))
-            elif fq >= 0.0:
+            elif fq >= -CLIP_TOL:
                 x = _crossing(p, q, edge)
                 out.append((x, _crossing_provenance(line, edge)))
                 out_lines.append(line)

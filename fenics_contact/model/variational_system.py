@@ -26,7 +26,9 @@ class VariationalSystem:
     vertex displacements w_k) that are a selection of ``unknowns[0]``
     (w_k = S_k u), with one more residual block each after the unknowns'
     blocks; ``transfer`` refreshes them (search) and names the selected
-    blocks (``sources()``, ``version``). A solver condenses them away
+    blocks (``sources()``, ``version``), or, for extras that are functions
+    of u rather than selections, gives their derivative (``condensation()``)
+    and second-derivative term (``curvature()``). A solver condenses them away
     (solvers/condensed.py).
     """
 
@@ -69,6 +71,21 @@ class Transfers:
     def sources(self) -> list[np.ndarray]:
         """Every contact's selections, in the order of the systems' extras."""
         return [s for t in self.transfers for s in t.sources()]
+
+    def condensation(self) -> list:
+        """Every contact's extras as selections (sources) or sparse derivatives, in order."""
+        out: list = []
+        for t in self.transfers:
+            out += list(t.condensation() if hasattr(t, "condensation") else t.sources())
+        return out
+
+    def curvature(self, residual_of) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The second-derivative terms of the contacts whose extras are not linear in u."""
+        parts = [t.curvature(residual_of) for t in self.transfers if hasattr(t, "curvature")]
+        if not parts:
+            empty = np.zeros(0, np.int64)
+            return empty, empty, np.zeros(0)
+        return tuple(np.concatenate(p) for p in zip(*parts, strict=True))
 
 
 __all__ = ["Transfers", "VariationalSystem", "Work", "jit_options"]

@@ -218,7 +218,8 @@ KEY_DOCS: dict[str, dict[str, KeyDoc]] = {
                                 "facet sizes, that a node does not search.", "facet sizes",
                                 field="PairSpec.neighbourhood"),
         "discretisation": KeyDoc('"node-to-segment" | "mortar"', "Node-to-segment, or mortar "
-                                 "(2D, with or without friction; exact on non-matching meshes).",
+                                 "(exact on non-matching meshes; 2D with or without friction, "
+                                 "3D frictionless).",
                                  field="PairSpec.discretisation"),
     },
     "pairing": {

@@ -54,7 +54,7 @@ Deformable bodies in one mesh replace [material] and [contact] by::
                  defaults to striker; one [[body]] is then enough), neighbourhood
                  (facet sizes along the surface a node does not search; default 3)
                  discretisation = "node-to-segment" (default) | "mortar"
-                 (2D, with or without mu; exact on non-matching meshes)
+                 (exact on non-matching meshes; 2D with or without mu, 3D without)
     [[obstacle]] as above, its tag on the facets of one body
 
 In every scene a [[dirichlet]] may give path = [[t, ux, uy], ...] (a

@@ -22,6 +22,7 @@ from __future__ import annotations
 import itertools
 
 import numpy as np
+import scipy.sparse as sp
 import ufl.algorithms
 from dolfinx import fem
 from dolfinx.fem import petsc as fem_petsc
@@ -114,25 +115,74 @@ class CondensedKernel(NewtonKernel):
         return self._red0[owner] + (blocks - self._vranges[owner]) * self._bs
 
     def _build_P(self) -> None:
-        """P: extended rows to reduced columns; identity on unknowns, S_k on extras."""
+        """P: extended rows to reduced columns; identity on unknowns, dw/du on extras.
+
+        An extra is either a 0/1 selection of V blocks (``sources()``) or, when
+        the transfer has ``condensation()``, any sparse derivative of the extra
+        with respect to u (rows: its owned dofs; columns: global V dofs).
+        """
         rank = self._comm.rank
+        counts = [np.ones(self._n_red, np.int64)]
         cols = [self._red0[rank] + np.arange(self._n_red, dtype=np.int64)]
-        for src in self.transfer.sources():
-            base = self._reduced_rows(np.asarray(src, np.int64).reshape(-1))
-            # a 2D source (node, row) selects for a packed coefficient of shape (rows, bs)
-            cols.append((base[:, None] + np.arange(self._bs)[None, :]).reshape(-1))
-        col = np.concatenate(cols).astype(PETSc.IntType)
-        assert col.size == self._n_ext
-        indptr = np.arange(self._n_ext + 1, dtype=PETSc.IntType)
+        vals = [np.ones(self._n_red)]
+        for item in _condensation(self.transfer):
+            if isinstance(item, np.ndarray):
+                base = self._reduced_rows(np.asarray(item, np.int64).reshape(-1))
+                # a 2D source (node, row) selects for a packed coefficient of shape (rows, bs)
+                col = (base[:, None] + np.arange(self._bs)[None, :]).reshape(-1)
+                counts.append(np.ones(col.size, np.int64))
+                cols.append(col)
+                vals.append(np.ones(col.size))
+            else:
+                rows = item.tocsr()
+                rows.sort_indices()
+                counts.append(np.diff(rows.indptr).astype(np.int64))
+                cols.append(self._reduced_dofs(rows.indices.astype(np.int64)))
+                vals.append(rows.data)
+        count = np.concatenate(counts)
+        assert count.size == self._n_ext
+        indptr = np.concatenate([[0], np.cumsum(count)]).astype(PETSc.IntType)
         if self.P is not None:
             self.P.destroy()
         self.P = PETSc.Mat().createAIJ(
             size=((self._n_ext, self._N_ext), (self._n_red, self._N_red)),
-            csr=(indptr, col, np.ones(self._n_ext)),
+            csr=(indptr, np.concatenate(cols).astype(PETSc.IntType), np.concatenate(vals)),
             comm=self._comm,
         )
         self.P.assemble()
         self._P_version = self.transfer.version
+
+    def _reduced_dofs(self, dofs: np.ndarray) -> np.ndarray:
+        """Global reduced rows of global V dofs (block * bs + component)."""
+        return self._reduced_rows(dofs // self._bs) + dofs % self._bs
+
+    def _extra_residual(self, f: object) -> np.ndarray:
+        """The owned entries of the extended residual of the unknown or extra ``f``."""
+        start = 0
+        for g in (*self.unknowns, *self.extras):
+            n = _owned(g.function_space)
+            if g is f:
+                return self.b_ext.getArray(readonly=True)[start : start + n].copy()
+            start += n
+        raise KeyError("not a block of this system")
+
+    def _add_curvature(self) -> None:
+        """A += sum_j (dL/dw_j) d^2 w_j / du^2 of extras that are not linear in u."""
+        curvature = getattr(self.transfer, "curvature", None)
+        if curvature is None:
+            return
+        with stopwatch(self.timings, "transfer_s"):
+            rows, cols, vals = curvature(self._extra_residual)
+            if rows.size:
+                m = sp.csr_matrix((vals, (self._reduced_dofs(rows), self._reduced_dofs(cols))),
+                                  shape=(self._N_red, self._N_red))
+                m.sum_duplicates()
+                start = np.flatnonzero(np.diff(m.indptr))
+                for i in start:
+                    lo, hi = m.indptr[i], m.indptr[i + 1]
+                    self.A.setValues(int(i), m.indices[lo:hi].astype(PETSc.IntType),
+                                     m.data[lo:hi], addv=PETSc.InsertMode.ADD_VALUES)
+            self.A.assemble()
 
     def _refresh(self) -> None:
         """Search and refill the target coefficients; new P when an assignment changed."""
@@ -192,6 +242,7 @@ class CondensedKernel(NewtonKernel):
     def _assemble_A(self) -> None:
         """Condensed Jacobian A = P^T J_ext P, Dirichlet elimination lifting b."""
         self._assemble_condensed_jacobian()
+        self._add_curvature()
         with stopwatch(self.timings, "transfer_s"):
             self.A.zeroRowsColumns(self._bc_rows, 1.0, self.z, self.b)
 
@@ -202,6 +253,13 @@ class CondensedKernel(NewtonKernel):
                     self.dx, self.z):
             if obj is not None:
                 obj.destroy()
+
+
+def _condensation(transfer) -> list:
+    """Each extra's condensation: a V-block selection, or a sparse derivative."""
+    if hasattr(transfer, "condensation"):
+        return list(transfer.condensation())
+    return list(transfer.sources())
 
 
 def kernel_for(
