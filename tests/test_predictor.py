@@ -9,6 +9,8 @@ predictor, 25 without.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -16,7 +18,7 @@ import fenics_contact  # noqa: F401  (before dolfinx)
 from benchmarks import cases
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings
-from fenics_contact.solvers.predictor import Extrapolated
+from fenics_contact.solvers.predictor import ActiveSetPredicted, Extrapolated
 from fenics_contact.solvers.stepping import solve_load_path
 
 CYLINDER = cases.hertz_cylinder(0.008, push=0.02, fine_radius=0.22)
@@ -66,3 +68,73 @@ def test_predictor_survives_cutbacks_and_outside_changes() -> None:
     # fields changed behind the predictor's back: it forgets its history
     problem.u.x.array[:] = 0.0
     assert not strategy.predict()
+
+
+# -- the active-set predictor (issue 21) ----------------------------------------------
+# Measured (10 steps, GNRM nodal, r = 1 E/h): medium mesh 19 -> 18 Newton iterations
+# (4 2 1 1 1 2 2 2 2 1), fine mesh (h = 0.004) 29 -> 18 (6 2 1 1 1 1 1 1 2 2); two cylinders
+# (node-to-segment) step 1 5 -> 4, 27 iterations in total either way.
+
+FINE = cases.hertz_cylinder(0.004, push=0.02, fine_radius=0.22)
+
+
+def predicted_path(scene, r: float, predictor: str) -> tuple:
+    problem = cases.build(scene, r, relative=True, quadrature="nodal")
+    strategy = make_strategy("gnrm", problem, SolverSettings(atol=1e-8), predictor=predictor)
+    return problem, solve_load_path(strategy, 10)
+
+
+def test_active_set_predictor_on_the_fine_hertz_mesh() -> None:
+    extrapolated, path_e = predicted_path(FINE, 1.0, "extrapolate")
+    predicted, path_p = predicted_path(FINE, 1.0, "active-set")
+    assert path_e.converged and path_p.converged
+    assert path_e.iterations == 29, [s.iterations for s in path_e.steps]
+    assert path_p.iterations <= 18, [s.iterations for s in path_p.steps]
+    # steps 3-8: the predicted set is the converged one (one Newton iteration each)
+    assert [s.iterations for s in path_p.steps[2:8]] == [1] * 6
+    scale = np.abs(extrapolated.u.x.array).max()
+    assert np.abs(predicted.u.x.array - extrapolated.u.x.array).max() < 1e-9 * scale
+    assert [s.active_count for s in path_e.steps] == [s.active_count for s in path_p.steps]
+
+
+def test_active_set_predictor_medium_mesh_for_every_r() -> None:
+    counts = {}
+    for r in (1e-2, 1.0, 1e6):
+        _, path = predicted_path(CYLINDER, r, "active-set")
+        assert path.converged, (r, path.status)
+        counts[r] = [s.iterations for s in path.steps]
+    assert len({tuple(c) for c in counts.values()}) == 1, counts
+    assert sum(counts[1.0]) <= 18, counts
+
+
+def test_active_set_predictor_first_step_of_two_cylinders() -> None:
+    """Touching nodes start in contact: step 1 takes 4 iterations (5 from an empty set)."""
+    from fenics_contact.scene.build import build_problem
+    from fenics_contact.scene.schema import load_scene
+
+    scene = load_scene(Path(__file__).parent.parent / "scenes" / "two_cylinders.toml")
+    runs = {}
+    for predictor in ("extrapolate", "active-set"):
+        problem = build_problem(scene)
+        strategy = make_strategy("gnrm", problem, scene.solver, predictor=predictor)
+        path = solve_load_path(strategy, scene.solver.steps)
+        assert path.converged
+        runs[predictor] = (problem, path)
+    (plain, path_e), (predicted, path_p) = runs["extrapolate"], runs["active-set"]
+    assert path_e.steps[0].iterations == 5
+    assert path_p.steps[0].iterations <= 4
+    assert path_p.iterations <= 27, [s.iterations for s in path_p.steps]
+    scale = np.abs(plain.u.x.array).max()
+    assert np.abs(predicted.u.x.array - plain.u.x.array).max() < 1e-8 * scale
+
+
+def test_active_set_predictor_resumed_history_has_no_gaps() -> None:
+    """A history set from outside drops the gaps: the next step decides by the extrapolation."""
+    problem = cases.build(CYLINDER, 1.0, relative=True, quadrature="nodal")
+    strategy = make_strategy("gnrm", problem, SolverSettings(atol=1e-8), predictor="active-set")
+    assert isinstance(strategy, ActiveSetPredicted)
+    solve_load_path(strategy, 10)
+    strategy.history = strategy.history
+    problem.set_load(1.0)
+    assert strategy.predict()
+    assert strategy.inner.solve().converged

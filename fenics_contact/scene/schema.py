@@ -40,7 +40,9 @@ Layout (units are the user's; be consistent)::
                  besides [[pair]]), r, relative, mu, tangential_r_max, margin
     [solver]     method, steps, max_iterations, atol, rtol, max_cutbacks,
                  predictor = "extrapolate" (start a step from the linear
-                 extrapolation of the last two) | "previous",
+                 extrapolation of the last two) | "previous" | "active-set"
+                 (extrapolate, and the first iteration's contact set from
+                 the gaps' history),
                  linear_solver = "direct" (MUMPS) | "iterative" (GMRES,
                  Schur field split, algebraic multigrid; for large 3D)
     [output]     fields = [...], pictures = true

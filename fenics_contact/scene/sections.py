@@ -195,7 +195,8 @@ def read_solver(reader: _Reader) -> SolverSpec:
         atol=reader.number("atol", 1e-8, positive=True),
         rtol=reader.number("rtol", 1e-10) if "rtol" in reader.table else 1e-10,
         max_cutbacks=bounded("max_cutbacks", 4, 0, MAX_CUTBACKS),
-        predictor=reader.choice("predictor", ("extrapolate", "previous"), default="extrapolate"),
+        predictor=reader.choice("predictor", ("extrapolate", "previous", "active-set"),
+                                default="extrapolate"),
         linear_solver=reader.choice("linear_solver", ("direct", "iterative"), default="direct"),
     )
 

@@ -12,7 +12,7 @@ from fenics_contact.solvers.gnrm import GeneralizedNewton
 from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.nua import NestedUzawa
 from fenics_contact.solvers.penalty import Penalty
-from fenics_contact.solvers.predictor import Extrapolated
+from fenics_contact.solvers.predictor import ActiveSetPredicted, Extrapolated
 from fenics_contact.solvers.sua import SimultaneousUzawa
 
 STRATEGIES: dict[str, type] = {
@@ -33,8 +33,9 @@ PAPER_NAMES = {
 }
 
 
-#: How a load step is started: from the last converged state, or extrapolated.
-PREDICTORS = ("previous", "extrapolate")
+#: How a load step is started: from the last converged state, extrapolated, or
+#: extrapolated with the first iteration's contact set chosen from the gaps' history.
+PREDICTORS = ("previous", "extrapolate", "active-set")
 
 
 def make_strategy(
@@ -57,7 +58,9 @@ def make_strategy(
             detection is switched on (see :class:`LinearSolverSettings`).
         observer: called with (iterations, residual) at every residual check.
         predictor: 'previous' starts each load step from the last converged
-            state; 'extrapolate' from the linear extrapolation of the last two.
+            state; 'extrapolate' from the linear extrapolation of the last two;
+            'active-set' also chooses the contact set of the first iteration
+            (:class:`~fenics_contact.solvers.predictor.ActiveSetPredicted`).
     """
     try:
         cls = STRATEGIES[name]
@@ -70,6 +73,8 @@ def make_strategy(
     if problem.shared_contact_nodes:  # contacts meet at nodes: equal rows are possible
         linear = replace(linear or LinearSolverSettings(), null_pivots=True)
     strategy: Strategy = cls(problem, settings, linear=linear, observer=observer)
+    if predictor == "active-set":
+        return ActiveSetPredicted(strategy)
     return Extrapolated(strategy) if predictor == "extrapolate" else strategy
 
 
