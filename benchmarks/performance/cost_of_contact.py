@@ -35,18 +35,17 @@ from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.base import newton_loop
 from fenics_contact.solvers.diagnostics import ConvergenceMonitor, SolverSettings
 from fenics_contact.solvers.newton import NewtonKernel
-from fenics_contact.solvers.predictor import Extrapolated
 from fenics_contact.solvers.stepping import solve_load_path
 
 SETTINGS = SolverSettings(atol=1e-8)
+#: The load-step predictors of the contact runs.
+CONTACT = ("active-set", "extrapolate", "previous")
 
 
 def contact_run(predictor: str) -> tuple[dict, ContactProblem]:
     """Solve with contact; return the record and the solved problem."""
     problem = cases.build(CYLINDER, 1.0, relative=True, quadrature="nodal")
-    strategy = make_strategy("gnrm", problem, SETTINGS)
-    if predictor == "extrapolate":
-        strategy = Extrapolated(strategy)
+    strategy = make_strategy("gnrm", problem, SETTINGS, predictor=predictor)
     kernel = strategy.kernel
     before = kernel.timings.snapshot()
     start = time.perf_counter()
@@ -127,16 +126,16 @@ def main() -> None:
     _, solved = contact_run("extrapolate")  # warm-up, and the final contact set
     equivalent = DirichletEquivalent(solved)
     equivalent.run()
-    runs: dict[str, list[dict]] = {"extrapolate": [], "previous": [], "dirichlet": []}
-    for _ in range(args.repeats):  # interleaved: the same machine load for all three
-        runs["extrapolate"].append(contact_run("extrapolate")[0])
-        runs["previous"].append(contact_run("previous")[0])
+    runs: dict[str, list[dict]] = {p: [] for p in (*CONTACT, "dirichlet")}
+    for _ in range(args.repeats):  # interleaved: the same machine load for all of them
+        for predictor in CONTACT:
+            runs[predictor].append(contact_run(predictor)[0])
         runs["dirichlet"].append(equivalent.run())
     med = {k: harness.median_dict(v) for k, v in runs.items()}
     ratios = {
         k: float(np.median([c["per_step_s"] / d["per_step_s"]
                             for c, d in zip(runs[k], runs["dirichlet"], strict=True)]))
-        for k in ("extrapolate", "previous")
+        for k in CONTACT
     }
     rows = [
         (m["case"], m["newton"], m["jacobians"], m["residuals"], m["per_step_s"] * 1e3,
