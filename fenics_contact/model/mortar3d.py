@@ -45,6 +45,9 @@ from fenics_contact.model.segments3d import segment_surfaces
 
 #: Segments per striker triangle the segment mesh is first made for (it grows when needed).
 SEGMENTS_PER_TRIANGLE = 8
+#: A striker triangle whose covered fraction is at least 1 - WHOLE weights its gaps with
+#: the dual basis; the others (at the target's borders) keep the standard one.
+WHOLE = 1e-2
 #: A node counts as covered when its covered area exceeds this fraction of its support.
 COVERED = 1e-8
 
@@ -117,10 +120,13 @@ class MortarTransfer3D:
         self.segment_count = int(self.comm.allreduce(k))
         if self.forms is None or k > self.forms.capacity:
             self._capacity = max(self._capacity, 2 * k)
-            self.forms = SegmentForms(self._capacity)
+            self.forms = SegmentForms(self._capacity, dual=True)
         forms = self.forms
         forms.fill(np.concatenate([xs[lo:hi][seg.striker], xt[seg.target]], axis=1),
                    provenance_weights(seg))
+        covered = np.zeros(hi - lo)
+        np.add.at(covered, seg.striker, seg.xi_areas())
+        forms.set_dual((covered >= 0.5 * (1.0 - WHOLE))[seg.striker].astype(float))
         # rows of each segment: its striker corners; columns: its six vertices' V dofs
         self._corner_vertex = s.facet_vertex[seg.striker + lo]
         blocks = np.concatenate([s.vertices[self._corner_vertex],

@@ -72,10 +72,16 @@ class SegmentForms:
     Args:
         capacity: the most segments it can hold.
         comm: the mesh's communicator (each process segments its own striker triangles).
+        dual: weight the gap with the dual basis Phi_j = 4 N_j - 1 of the striker
+            triangle (int Phi_j N_k = delta_jk int N_k) instead of N_j on the cells
+            whose ``theta`` is 1 (striker triangles the target covers whole); the
+            covered area keeps N_j. See :mod:`.mortar3d`.
     """
 
-    def __init__(self, capacity: int, comm: MPI.Comm = MPI.COMM_SELF) -> None:
+    def __init__(self, capacity: int, comm: MPI.Comm = MPI.COMM_SELF, *,
+                 dual: bool = False) -> None:
         self.capacity = int(capacity)
+        self.dual = bool(dual)
         x = np.tile(REFERENCE, (self.capacity, 1))
         cells = np.arange(3 * self.capacity, dtype=np.int64).reshape(-1, 3)
         element = basix.ufl.element("Lagrange", "triangle", 1, shape=(2,))
@@ -89,15 +95,20 @@ class SegmentForms:
         self.V3 = fem.functionspace(self.mesh, ("DG", 0, (3,)))
         self.count = 0
         gap, jac, shape = self._integrand()
+        #: 1 on the segments of a wholly covered striker triangle (dual basis), else 0.
+        self.theta = fem.Function(fem.functionspace(self.mesh, ("DG", 0)), name="dual")
+        weight = shape
+        if self.dual:
+            weight = shape + self.theta * (3.0 * shape - ufl.as_vector([1.0, 1.0, 1.0]))
         v = ufl.TestFunction(self.V3)
         dx = ufl.dx(metadata={"quadrature_degree": 2})  # N_j g is quadratic on a segment
-        self.gap_form = ufl.dot(shape * gap * jac, v) * dx
+        self.gap_form = ufl.dot(weight * gap * jac, v) * dx
         self.weight_form = ufl.dot(shape * jac, v) * dx
         #: Corner weights of the weighted gaps (a) and covered areas (b) in :attr:`hessian_form`.
         self.a = fem.Function(self.V3, name="gap_weights")
         self.b = fem.Function(self.V3, name="area_weights")
         dw, dW = ufl.TestFunction(self.W6), ufl.TrialFunction(self.W6)
-        weighted = (ufl.dot(self.a, shape) * gap + ufl.dot(self.b, shape)) * jac * dx
+        weighted = (ufl.dot(self.a, weight) * gap + ufl.dot(self.b, shape)) * jac * dx
         self.gap_tangent_form = ufl.derivative(self.gap_form, self.w, dW)
         self.weight_tangent_form = ufl.derivative(self.weight_form, self.w, dW)
         self.hessian_form = ufl.derivative(ufl.derivative(weighted, self.w, dw), self.w, dW)
@@ -208,6 +219,12 @@ class SegmentForms:
         self.provenance.x.array[:] = allp[self.cell_rows].reshape(-1)
         self.w.x.array[:] = 0.0
         self.count = k
+
+    def set_dual(self, theta: np.ndarray) -> None:
+        """Load the (count,) dual flags of the segments (0 in unused cells)."""
+        full = np.zeros(self.capacity)
+        full[: self.count] = theta
+        self.theta.x.array[:] = full[self.cell_rows]
 
     def set_corner_weights(self, a: np.ndarray, b: np.ndarray) -> None:
         """Load the (count, 3) corner weights of :attr:`hessian_form` (zero in unused cells)."""

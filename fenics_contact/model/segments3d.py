@@ -88,19 +88,27 @@ class Segments:
         return 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
 
 
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a x b of two 3-vectors (..., 3), written out (np.cross is slow on small arrays)."""
+    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+                     a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
+
+
 def unit_normal(tri: np.ndarray) -> np.ndarray:
     """Unit normal (s_1 - s_0) x (s_2 - s_0) / |...| of triangles (..., 3, 3)."""
-    n = np.cross(tri[..., 1, :] - tri[..., 0, :], tri[..., 2, :] - tri[..., 0, :])
-    return n / np.linalg.norm(n, axis=-1, keepdims=True)
+    n = _cross(tri[..., 1, :] - tri[..., 0, :], tri[..., 2, :] - tri[..., 0, :])
+    return n / np.sqrt(np.sum(n * n, axis=-1, keepdims=True))
 
 
 def local_coordinates(striker: np.ndarray, points: np.ndarray) -> np.ndarray:
     """Local coordinates xi of points (k, 3) projected along a striker triangle's normal."""
     e1, e2 = striker[1] - striker[0], striker[2] - striker[0]
-    n = np.cross(e1, e2)
+    n = _cross(e1, e2)
+    nn = float(n @ n)
     # dual vectors: m_a . e_b = delta_ab and m_a . n = 0, so the normal offset drops out
-    m1 = np.cross(e2, n) / np.dot(np.cross(e1, e2), n)
-    m2 = np.cross(n, e1) / np.dot(np.cross(e1, e2), n)
+    m1 = _cross(e2, n) / nn
+    m2 = _cross(n, e1) / nn
     d = points - striker[0]
     return np.stack([d @ m1, d @ m2], axis=-1)
 
@@ -207,7 +215,7 @@ def segment_pair(striker: np.ndarray, target: np.ndarray) -> list[tuple[np.ndarr
     Each segment: (corners xi (3, 2), ((kind, i, j) for each corner)). Empty
     when the projections do not overlap or the target does not face the striker.
     """
-    if np.dot(unit_normal(striker), unit_normal(target)) > -OPPOSING:
+    if float(unit_normal(striker) @ unit_normal(target)) > -OPPOSING:
         return []
     polygon = clip(local_coordinates(striker, target))
     if len(polygon) < 3:
@@ -227,21 +235,37 @@ def segment_surfaces(striker: np.ndarray, target: np.ndarray,
                      reach: float | None = None) -> Segments:
     """Every segment of a striker surface (n, 3, 3) against a target surface (m, 3, 3).
 
-    ``reach``: target triangles whose centroid lies farther than this from a
-    striker triangle's centroid are not tried (default: twice the largest
-    triangle size of either surface).
+    ``reach``: target triangles farther than this from a striker triangle's
+    plane (normal distance between centroids) are not tried (default: twice
+    the largest triangle size of either surface). Candidates come from a
+    k-d tree on the target centroids and are filtered in bulk (facing,
+    normal distance, lateral distance against the two triangles' radii)
+    before any triangle is clipped.
     """
     from scipy.spatial import cKDTree
 
     striker, target = np.asarray(striker, float), np.asarray(target, float)
     size = max(_largest_size(striker), _largest_size(target))
     reach = 2.0 * size if reach is None else reach
-    tree = cKDTree(target.mean(axis=1))
+    cs, ct = striker.mean(axis=1), target.mean(axis=1)
+    rs = np.linalg.norm(striker - cs[:, None], axis=-1).max(axis=1) if len(cs) else cs[:, 0]
+    rt = np.linalg.norm(target - ct[:, None], axis=-1).max(axis=1) if len(ct) else ct[:, 0]
     rows: list[tuple[int, int, np.ndarray, tuple]] = []
-    for s, near in enumerate(tree.query_ball_point(striker.mean(axis=1), reach)):
-        for t in sorted(near):
+    if len(cs) and len(ct):
+        tree = cKDTree(ct)
+        near = tree.query_ball_point(cs, rs + rt.max() + reach)
+        s_idx = np.repeat(np.arange(len(cs)), [len(n) for n in near])
+        t_idx = np.fromiter((t for n in near for t in n), np.int64, count=s_idx.size)
+        ns, nt = unit_normal(striker), unit_normal(target)
+        d = ct[t_idx] - cs[s_idx]
+        normal = np.einsum("ij,ij->i", d, ns[s_idx])
+        lateral = np.linalg.norm(d - normal[:, None] * ns[s_idx], axis=1)
+        keep = ((np.einsum("ij,ij->i", ns[s_idx], nt[t_idx]) <= -OPPOSING)
+                & (np.abs(normal) <= reach) & (lateral <= rs[s_idx] + rt[t_idx]))
+        order = np.lexsort((t_idx[keep], s_idx[keep]))
+        for s, t in zip(s_idx[keep][order], t_idx[keep][order], strict=True):
             for xi, prov in segment_pair(striker[s], target[t]):
-                rows.append((s, t, xi, prov))
+                rows.append((int(s), int(t), xi, prov))
     if not rows:
         empty = np.zeros(0, np.int64)
         return Segments(empty, empty, np.zeros((0, 3, 2)), np.zeros((0, 3), np.int64),
