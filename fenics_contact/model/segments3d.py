@@ -89,7 +89,7 @@ class Segments:
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a x b of two 3-vectors (..., 3), written out (np.cross is slow on small arrays)."""
+    """A x b of two 3-vectors (..., 3), written out (np.cross is slow on small arrays)."""
     return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
                      a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
                      a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
