@@ -319,7 +319,7 @@ class MortarContact(Contact):
                                  "version; use discretisation = \"node-to-segment\" for a "
                                  "frictional 3D pair.")
             self.mortar = MortarTransfer3D(solid.V, solid.u, self.surface, self.target_facets,
-                                           self.surface.h)
+                                           self.surface.h, self.lam)
             self.mortar.refresh()
             return self.mortar.G
         self.mortar = MortarTransfer(solid.V, solid.u, self.surface, self.target_facets,

@@ -48,6 +48,8 @@ SEGMENTS_PER_TRIANGLE = 8
 #: A striker triangle whose covered fraction is at least 1 - WHOLE weights its gaps with
 #: the dual basis; the others (at the target's borders) keep the standard one.
 WHOLE = 1e-2
+#: A node with G below this fraction of the open gap h is engaged (its derivatives kept).
+ENGAGED = 1e-3
 #: A node counts as covered when its covered area exceeds this fraction of its support.
 COVERED = 1e-8
 
@@ -66,10 +68,12 @@ class MortarTransfer3D:
         surface: the striker's contact surface (its submesh carries lam and G).
         target_facets: local facet indices of the target surface (triangles).
         open_gap: G of an uncovered node (length).
+        lam: the pair's multiplier (nodes where it is nonzero are always engaged).
     """
 
     def __init__(self, V: fem.FunctionSpace, u: fem.Function, surface: ContactSurface,
-                 target_facets: np.ndarray, open_gap: float) -> None:
+                 target_facets: np.ndarray, open_gap: float,
+                 lam: fem.Function | None = None) -> None:
         self.V, self.u, self.comm = V, u, V.mesh.comm
         self.striker = Polyline(V, surface.facets, dim=3)
         self.target = Polyline(V, target_facets, dim=3)
@@ -97,15 +101,36 @@ class MortarTransfer3D:
         self.n_dofs = V.dofmap.index_map.size_global * 3
         lo, hi = self.striker.owned
         self._capacity = max(SEGMENTS_PER_TRIANGLE * (hi - lo), 16)
-        self.forms: SegmentForms | None = None
+        self._segment_forms: dict[str, SegmentForms] = {}
+        self.lam = lam
+        self.engaged_count = 0
         self.version = 0
         self.search_count = 0
         self.segment_count = 0
         self._searched_u: np.ndarray | None = None
 
+    @property
+    def forms(self) -> SegmentForms:
+        """The segment mesh holding every segment of the last search."""
+        return self._segment_forms["all"]
+
     # -- search and nodal gaps -------------------------------------------------------
+    def _forms(self, which: str, k: int) -> SegmentForms:
+        """The segment mesh ``which`` ('all' or 'near'), large enough for k segments."""
+        forms = self._segment_forms.get(which)
+        if forms is None or k > forms.capacity:
+            capacity = max(self._capacity if which == "all" else 16, 2 * k)
+            forms = self._segment_forms[which] = SegmentForms(capacity, dual=True)
+        return forms
+
     def refresh(self) -> bool:
-        """Segment, assemble G and dG/du at the current u; True when they changed (any rank)."""
+        """Segment, assemble G and dG/du at the current u; True when they changed (any rank).
+
+        The derivatives are assembled only on the segments of *engaged* nodes
+        (G_j <= 1e-3 h or lam_j != 0): every other node is inactive (lam + r G > 0,
+        or G > 0 for the penalty), its residual and tangent vanish, and its row of
+        dG/du is zero without loss.
+        """
         same = self._searched_u is not None and np.array_equal(self._searched_u, self.u.x.array)
         if not any_rank(self.comm, not same):
             return False
@@ -118,49 +143,57 @@ class MortarTransfer3D:
         seg = segment_surfaces(xs[lo:hi], xt, self.reach)
         k = len(seg)
         self.segment_count = int(self.comm.allreduce(k))
-        if self.forms is None or k > self.forms.capacity:
-            self._capacity = max(self._capacity, 2 * k)
-            self.forms = SegmentForms(self._capacity, dual=True)
-        forms = self.forms
-        forms.fill(np.concatenate([xs[lo:hi][seg.striker], xt[seg.target]], axis=1),
-                   provenance_weights(seg))
+        vertices = np.concatenate([xs[lo:hi][seg.striker], xt[seg.target]], axis=1)
+        provenance = provenance_weights(seg)
         covered = np.zeros(hi - lo)
         np.add.at(covered, seg.striker, seg.xi_areas())
-        forms.set_dual((covered >= 0.5 * (1.0 - WHOLE))[seg.striker].astype(float))
-        # rows of each segment: its striker corners; columns: its six vertices' V dofs
-        self._corner_vertex = s.facet_vertex[seg.striker + lo]
-        blocks = np.concatenate([s.vertices[self._corner_vertex],
+        theta = (covered >= 0.5 * (1.0 - WHOLE))[seg.striker].astype(float)
+        corner_vertex = s.facet_vertex[seg.striker + lo]
+        blocks = np.concatenate([s.vertices[corner_vertex],
                                  t.vertices[t.facet_vertex[seg.target]]], axis=1)
-        self._segment_dofs = (3 * blocks[:, :, None] + np.arange(3)).reshape(k, 18)
+        segment_dofs = (3 * blocks[:, :, None] + np.arange(3)).reshape(k, 18)
+        forms = self._forms("all", k)
+        forms.fill(vertices, provenance)
+        forms.set_dual(theta)
         compiled = forms.compiled()
         n = s.vertices.size
         g = np.zeros(n)
         area = np.zeros(n)
-        np.add.at(g, self._corner_vertex, forms.per_segment(
-            fem.assemble_vector(compiled["gap"]).array))
-        np.add.at(area, self._corner_vertex, forms.per_segment(
-            fem.assemble_vector(compiled["weight"]).array))
+        np.add.at(g, corner_vertex, forms.per_segment(fem.assemble_vector(compiled["gap"]).array))
+        np.add.at(area, corner_vertex,
+                  forms.per_segment(fem.assemble_vector(compiled["weight"]).array))
         g = self.comm.allreduce(g)
         area = self.comm.allreduce(area)
-        dg = self._gathered_rows("gap_tangent")
-        dA = self._gathered_rows("weight_tangent")
         covered = area > COVERED * self.support
         inv = np.where(covered, 1.0 / np.where(covered, area, 1.0), 0.0)
         G = np.where(covered, g * inv, self.open_gap)
-        self.dG = (sp.diags(inv) @ (dg - sp.diags(np.where(covered, G, 0.0)) @ dA)).tocsr()
+        engaged = covered & (G <= ENGAGED * self.open_gap)
+        if self.lam is not None:
+            lam = np.zeros(n)
+            lam[self.q_vertex[: self.n_owned]] = self.lam.x.array[: self.n_owned]
+            engaged |= covered & (self.comm.allreduce(lam) != 0.0)
+        near = np.flatnonzero(np.any(engaged[corner_vertex], axis=1))
+        self.engaged_count = int(np.count_nonzero(engaged))
+        near_forms = self._forms("near", near.size)
+        near_forms.fill(vertices[near], provenance[near])
+        near_forms.set_dual(theta[near])
+        self._corner_vertex, self._segment_dofs = corner_vertex[near], segment_dofs[near]
+        dg = self._gathered_rows("gap_tangent")
+        dA = self._gathered_rows("weight_tangent")
+        scale = np.where(engaged, inv, 0.0)
+        self.dG = (sp.diags(scale) @ (dg - sp.diags(np.where(engaged, G, 0.0)) @ dA)).tocsr()
         self.dA = dA
-        self.values, self.area, self.covered, self._inv = G, area, covered, inv
+        self.values, self.area, self.covered, self._inv = G, area, covered, scale
         self.G.x.array[:] = G[self.q_vertex]
         self.version += 1
         return True
 
     def _gathered_rows(self, name: str) -> sp.csr_matrix:
         """A per-segment (3 x 18) derivative summed into striker-node rows and V-dof columns."""
-        forms = self.forms
+        forms = self._segment_forms["near"]
         matrix = forms.assemble_matrix(name).tocoo()
         (rows3, corner), (rows18, pos) = forms.cell_dofs()
-        k = forms.count
-        keep = rows3[matrix.row] < k
+        keep = rows3[matrix.row] < forms.count
         r, c, v = matrix.row[keep], matrix.col[keep], matrix.data[keep]
         node = self._corner_vertex[rows3[r], corner[r]]
         dof = self._segment_dofs[rows18[c], pos[c]]
@@ -183,7 +216,7 @@ class MortarTransfer3D:
         c = self.comm.allreduce(c)
         a = c * self._inv
         b = -a * np.where(self.covered, self.values, 0.0)
-        forms = self.forms
+        forms = self._segment_forms["near"]
         forms.set_corner_weights(a[self._corner_vertex], b[self._corner_vertex])
         H = forms.assemble_matrix("hessian").tocoo()
         _, (rows18, pos) = forms.cell_dofs()
