@@ -6,12 +6,17 @@ import numpy as np
 import pytest
 
 from fenics_contact.model.segments3d import (
+    CLIP_TOL,
     EDGE_CROSSING,
     STRIKER_VERTEX,
     TARGET_VERTEX,
+    Segments,
+    candidate_pairs,
     clip,
     corner_from_provenance,
     segment_pair,
+    segment_pairs,
+    segment_pairs_loop,
     segment_surfaces,
     weighted_gaps,
 )
@@ -228,3 +233,126 @@ def test_ufl_segment_forms_give_the_weighted_gaps_and_their_tangent() -> None:
     print(f"tangent against central differences: {error:.2e}")
     assert error <= 1e-7
 
+
+
+# -- the vectorised segmentation against the pair-by-pair reference ---------------------
+
+
+def _assert_same_segments(got: Segments, expected: Segments) -> None:
+    assert len(got) == len(expected)
+    np.testing.assert_array_equal(got.striker, expected.striker)
+    np.testing.assert_array_equal(got.target, expected.target)
+    np.testing.assert_array_equal(got.kind, expected.kind)
+    np.testing.assert_array_equal(got.index, expected.index)
+    np.testing.assert_allclose(got.xi, expected.xi, rtol=0.0, atol=1e-14)
+    assert got.xi.shape == (len(expected), 3, 2)
+    assert got.kind.shape == (len(expected), 3) and got.index.shape == (len(expected), 3, 2)
+
+
+def _surfaces_against_reference(striker: np.ndarray, target: np.ndarray,
+                                reach: float | None = None) -> Segments:
+    """segment_surfaces, checked against segment_pair applied to each candidate pair."""
+    got = segment_surfaces(striker, target, reach)
+    _assert_same_segments(got, segment_pairs_loop(striker, target,
+                                                  *candidate_pairs(striker, target, reach)))
+    return got
+
+
+def _kinds(segments: Segments) -> set[int]:
+    return set(np.unique(segments.kind).tolist())
+
+
+def _on_sphere(points: np.ndarray, radius: float, below: bool) -> np.ndarray:
+    """The unit square's points mapped onto a spherical cap touching z = 0 at its centre."""
+    x, y = points[:, 0] - 0.5, points[:, 1] - 0.5
+    z = radius - np.sqrt(radius**2 - x**2 - y**2)
+    return np.column_stack([x, y, -z if below else z])
+
+
+def _pair_by_pair_cases() -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    cases = {}
+    ps, cs = _grid_surface(9, 7, 0.0, flip=False, jitter=0.3)
+    pt, ct = _grid_surface(11, 13, 0.01, flip=True, jitter=0.3)
+    cases["jittered grids"] = (ps[cs], pt[ct])
+    ps, cs = _grid_surface(8, 8, 0.0, flip=False)
+    pt, ct = _grid_surface(8, 8, 0.0, flip=True)
+    cases["matching grids (coincident rims)"] = (ps[cs], pt[ct])
+    pt, ct = _grid_surface(16, 4, 0.0, flip=True)
+    cases["nested grids (vertices on edges)"] = (ps[cs], pt[ct])
+    pt, ct = _grid_surface(8, 8, 0.0, flip=True)
+    pt[:, :2] += 1e-7 * RNG.uniform(-1, 1, (pt.shape[0], 2))  # inside the tolerance
+    cases["matching grids moved by 1e-7"] = (ps[cs], pt[ct])
+    pt, ct = _grid_surface(10, 6, 0.03, flip=True, jitter=0.2, tilt=(0.2, -0.3))
+    cases["tilted target"] = (ps[cs], pt[ct])
+    ps, cs = _grid_surface(8, 9, 0.0, flip=False, jitter=0.2)
+    pt, ct = _grid_surface(10, 7, 0.0, flip=True, jitter=0.2)
+    cases["spherical caps"] = (_on_sphere(ps, 1.0, below=False)[cs],
+                               _on_sphere(pt, 1.0, below=True)[ct] + [0.0, 0.0, -0.005])
+    return cases
+
+
+@pytest.mark.parametrize("case", sorted(_pair_by_pair_cases()))
+def test_vectorised_segmentation_equals_the_pair_by_pair_reference(case: str) -> None:
+    """The same segments, in the same order, with the same provenance and corners."""
+    striker, target = _pair_by_pair_cases()[case]
+    segments = _surfaces_against_reference(striker, target)
+    assert np.unique(segments.striker).size >= 0.6 * len(striker)
+    assert TARGET_VERTEX in _kinds(segments)
+
+
+def test_vectorised_segmentation_of_every_pair_of_random_triangles() -> None:
+    """All pairs of random triangles (overlapping or not, facing or not, either
+    orientation), against segment_pair one pair at a time."""
+    striker = RNG.uniform(0.0, 1.0, (25, 3, 3)) * [1.0, 1.0, 0.1]
+    target = RNG.uniform(-0.2, 1.2, (40, 3, 3)) * [1.0, 1.0, 0.1] + [0.0, 0.0, 0.05]
+    s_idx, t_idx = (a.ravel() for a in np.meshgrid(np.arange(25), np.arange(40),
+                                                   indexing="ij"))
+    expected = segment_pairs_loop(striker, target, s_idx, t_idx)
+    _assert_same_segments(segment_pairs(striker, target, s_idx, t_idx), expected)
+    assert len(expected) > 200
+    assert _kinds(expected) == {STRIKER_VERTEX, TARGET_VERTEX, EDGE_CROSSING}
+    # any order of the pairs, repeated pairs too
+    shuffled = RNG.permutation(np.concatenate([np.arange(s_idx.size), np.arange(50)]))
+    _assert_same_segments(segment_pairs(striker, target, s_idx[shuffled], t_idx[shuffled]),
+                          segment_pairs_loop(striker, target, s_idx[shuffled], t_idx[shuffled]))
+
+
+def test_vectorised_clipping_at_the_tolerance_and_on_the_edges() -> None:
+    """Target vertices exactly on the striker's edges and corners, or just inside or
+    outside them within and beyond CLIP_TOL (the crossings of nearly collinear edges,
+    repeated vertices, slivers dropped), against the reference triangle's own plane."""
+    striker = np.array([[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]])
+    values = np.array([-0.5, 0.0, 0.25, 0.5, 1.0, 1.5])
+    offsets = np.array([0.0, 1e-15, -1e-15, 0.5, -0.5, 1.0, -1.0, 1.5, -1.5, 3.0]) * CLIP_TOL
+    xi = (RNG.choice(values, (4000, 3, 2))
+          + RNG.choice(offsets, (4000, 3, 2)) * (RNG.uniform(size=(4000, 3, 1)) < 0.7))
+    # on the hypotenuse, with or without an offset
+    on_hypotenuse = RNG.uniform(size=(4000, 3)) < 0.3
+    xi[..., 1] = np.where(on_hypotenuse, 1.0 - xi[..., 0] + RNG.choice(offsets, (4000, 3)),
+                          xi[..., 1])
+    # facing the striker: clockwise seen from above
+    e1, e2 = xi[:, 1] - xi[:, 0], xi[:, 2] - xi[:, 0]
+    clockwise = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0] < 0
+    xi = np.where(clockwise[:, None, None], xi, xi[:, ::-1])
+    target = np.concatenate([xi, np.full((4000, 3, 1), 0.01)], axis=-1)
+    s_idx, t_idx = np.zeros(4000, np.int64), np.arange(4000)
+    with np.errstate(invalid="ignore"):  # a few targets are degenerate (no normal)
+        expected = segment_pairs_loop(striker, target, s_idx, t_idx)
+        _assert_same_segments(segment_pairs(striker, target, s_idx, t_idx), expected)
+    assert len(expected) > 2000
+    assert _kinds(expected) == {STRIKER_VERTEX, TARGET_VERTEX, EDGE_CROSSING}
+    # some corners kept outside the striker within the tolerance
+    outside = np.minimum.reduce([expected.xi[..., 0], expected.xi[..., 1],
+                                 1.0 - expected.xi.sum(axis=-1)])
+    assert outside.min() < -0.4 * CLIP_TOL
+
+
+def test_no_pairs_give_no_segments() -> None:
+    striker = RNG.uniform(size=(4, 3, 3))
+    for segments in (segment_surfaces(striker, np.zeros((0, 3, 3))),
+                     segment_surfaces(np.zeros((0, 3, 3)), striker),
+                     segment_surfaces(striker, striker + np.array([10.0, 0.0, 0.0])),
+                     segment_pairs(striker, striker, np.zeros(0, int), np.zeros(0, int))):
+        assert len(segments) == 0
+        assert segments.xi.shape == (0, 3, 2) and segments.index.shape == (0, 3, 2)
+        assert segments.kind.shape == (0, 3)

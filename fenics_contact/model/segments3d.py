@@ -37,6 +37,7 @@ Wall, IJNME 79 (2009) 1354-1391 (segment-based integration in 3D).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import chain
 
 import numpy as np
 
@@ -231,45 +232,66 @@ def segment_pair(striker: np.ndarray, target: np.ndarray) -> list[tuple[np.ndarr
     return out
 
 
-def segment_surfaces(striker: np.ndarray, target: np.ndarray,
-                     reach: float | None = None) -> Segments:
-    """Every segment of a striker surface (n, 3, 3) against a target surface (m, 3, 3).
+def candidate_pairs(striker: np.ndarray, target: np.ndarray,
+                    reach: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The (striker, target) triangle pairs worth clipping, sorted by striker then target.
 
     ``reach``: target triangles farther than this from a striker triangle's
     plane (normal distance between centroids) are not tried (default: twice
     the largest triangle size of either surface). Candidates come from a
     k-d tree on the target centroids and are filtered in bulk (facing,
-    normal distance, lateral distance against the two triangles' radii)
-    before any triangle is clipped.
+    normal distance, lateral distance against the two triangles' radii).
     """
     from scipy.spatial import cKDTree
 
     striker, target = np.asarray(striker, float), np.asarray(target, float)
+    empty = np.zeros(0, np.int64)
+    if not (len(striker) and len(target)):
+        return empty, empty
     size = max(_largest_size(striker), _largest_size(target))
     reach = 2.0 * size if reach is None else reach
     cs, ct = striker.mean(axis=1), target.mean(axis=1)
-    rs = np.linalg.norm(striker - cs[:, None], axis=-1).max(axis=1) if len(cs) else cs[:, 0]
-    rt = np.linalg.norm(target - ct[:, None], axis=-1).max(axis=1) if len(ct) else ct[:, 0]
+    rs = np.linalg.norm(striker - cs[:, None], axis=-1).max(axis=1)
+    rt = np.linalg.norm(target - ct[:, None], axis=-1).max(axis=1)
+    # a pair kept below has normal distance <= reach and lateral distance <= rs + rt
+    radius = np.sqrt(reach**2 + (rs + rt.max()) ** 2) * (1.0 + 1e-12)
+    near = cKDTree(ct).query_ball_point(cs, radius)
+    s_idx = np.repeat(np.arange(len(cs)), [len(n) for n in near])
+    t_idx = np.fromiter(chain.from_iterable(near), np.int64, count=s_idx.size)
+    ns, nt = unit_normal(striker), unit_normal(target)
+    ns_pair = ns[s_idx]
+    facing = np.einsum("ij,ij->i", ns_pair, nt[t_idx]) <= -OPPOSING
+    s_idx, t_idx, ns_pair = s_idx[facing], t_idx[facing], ns_pair[facing]
+    d = ct[t_idx] - cs[s_idx]
+    normal = np.einsum("ij,ij->i", d, ns_pair)
+    lateral = np.linalg.norm(d - normal[:, None] * ns_pair, axis=1)
+    keep = (np.abs(normal) <= reach) & (lateral <= rs[s_idx] + rt[t_idx])
+    s_idx, t_idx = s_idx[keep], t_idx[keep]
+    order = np.lexsort((t_idx, s_idx))
+    return s_idx[order], t_idx[order]
+
+
+def segment_surfaces(striker: np.ndarray, target: np.ndarray,
+                     reach: float | None = None) -> Segments:
+    """Every segment of a striker surface (n, 3, 3) against a target surface (m, 3, 3).
+
+    The pairs of :func:`candidate_pairs` (``reach`` as there), clipped all at
+    once by :func:`segment_pairs`; segments sorted by striker then target triangle.
+    """
+    striker, target = np.asarray(striker, float), np.asarray(target, float)
+    return segment_pairs(striker, target, *candidate_pairs(striker, target, reach))
+
+
+def segment_pairs_loop(striker: np.ndarray, target: np.ndarray, s_idx: np.ndarray,
+                       t_idx: np.ndarray) -> Segments:
+    """:func:`segment_pairs` pair by pair with :func:`segment_pair` (the reference)."""
+    striker, target = np.asarray(striker, float), np.asarray(target, float)
     rows: list[tuple[int, int, np.ndarray, tuple]] = []
-    if len(cs) and len(ct):
-        tree = cKDTree(ct)
-        near = tree.query_ball_point(cs, rs + rt.max() + reach)
-        s_idx = np.repeat(np.arange(len(cs)), [len(n) for n in near])
-        t_idx = np.fromiter((t for n in near for t in n), np.int64, count=s_idx.size)
-        ns, nt = unit_normal(striker), unit_normal(target)
-        d = ct[t_idx] - cs[s_idx]
-        normal = np.einsum("ij,ij->i", d, ns[s_idx])
-        lateral = np.linalg.norm(d - normal[:, None] * ns[s_idx], axis=1)
-        keep = ((np.einsum("ij,ij->i", ns[s_idx], nt[t_idx]) <= -OPPOSING)
-                & (np.abs(normal) <= reach) & (lateral <= rs[s_idx] + rt[t_idx]))
-        order = np.lexsort((t_idx[keep], s_idx[keep]))
-        for s, t in zip(s_idx[keep][order], t_idx[keep][order], strict=True):
-            for xi, prov in segment_pair(striker[s], target[t]):
-                rows.append((int(s), int(t), xi, prov))
+    for s, t in zip(s_idx, t_idx, strict=True):
+        for xi, prov in segment_pair(striker[s], target[t]):
+            rows.append((int(s), int(t), xi, prov))
     if not rows:
-        empty = np.zeros(0, np.int64)
-        return Segments(empty, empty, np.zeros((0, 3, 2)), np.zeros((0, 3), np.int64),
-                        np.zeros((0, 3, 2), np.int64))
+        return _no_segments()
     return Segments(
         striker=np.array([r[0] for r in rows], np.int64),
         target=np.array([r[1] for r in rows], np.int64),
@@ -277,6 +299,185 @@ def segment_surfaces(striker: np.ndarray, target: np.ndarray,
         kind=np.array([[p[0] for p in r[3]] for r in rows], np.int64),
         index=np.array([[[p[1], p[2]] for p in r[3]] for r in rows], np.int64),
     )
+
+
+def _no_segments() -> Segments:
+    empty = np.zeros(0, np.int64)
+    return Segments(empty, empty, np.zeros((0, 3, 2)), np.zeros((0, 3), np.int64),
+                    np.zeros((0, 3, 2), np.int64))
+
+
+#: The corner two striker edges share: _SHARED[i, j] for edges i != j.
+_SHARED = np.array([[-1, 1, 0], [1, -1, 2], [0, 2, -1]])
+#: Kinds of the line an edge of the clipped polygon lies on: a target edge or a striker edge.
+_ON_TARGET, _ON_STRIKER = 0, 1
+
+
+def segment_pairs(striker: np.ndarray, target: np.ndarray, s_idx: np.ndarray,
+                  t_idx: np.ndarray) -> Segments:
+    """The segments of the triangle pairs (striker[s_idx[p]], target[t_idx[p]]), all at once.
+
+    The same segments, in the same order (pair by pair, then fanned from the
+    polygon's first vertex), with the same provenance as :func:`segment_pair`
+    applied to each pair in turn (:func:`segment_pairs_loop`), computed with
+    array operations over all pairs: every polygon is a fixed-width buffer of
+    vertices with a count, clipped against the three striker edges in turn.
+    """
+    striker, target = np.asarray(striker, float), np.asarray(target, float)
+    s_idx, t_idx = np.asarray(s_idx, np.int64), np.asarray(t_idx, np.int64)
+    tri_s, tri_t = striker[s_idx], target[t_idx]
+    ns, nt = unit_normal(tri_s), unit_normal(tri_t)
+    facing = ~(ns[:, 0] * nt[:, 0] + ns[:, 1] * nt[:, 1] + ns[:, 2] * nt[:, 2] > -OPPOSING)
+    s_idx, t_idx, tri_s, tri_t = s_idx[facing], t_idx[facing], tri_s[facing], tri_t[facing]
+    if not s_idx.size:
+        return _no_segments()
+    alive, x, prov, count = _clip_all(_local_coordinates_all(tri_s, tri_t))
+    s_idx, t_idx = s_idx[alive], t_idx[alive]
+    x, prov, count = _without_repeats_all(x, prov, count)
+    # fan from vertex 0: triangles (0, k, k + 1), k = 1 .. count - 2
+    width = x.shape[1]
+    if width < 3:
+        return _no_segments()
+    k = np.arange(1, width - 1)
+    x0 = x[:, :1]
+    e1, e2 = x[:, 1:-1] - x0, x[:, 2:] - x0
+    area = 0.5 * np.abs(e1[..., 0] * e2[..., 1] - e1[..., 1] * e2[..., 0])
+    keep = (k[None, :] + 1 < count[:, None]) & ~(area <= AREA_TOL)
+    pair, column = np.nonzero(keep)
+    corners = np.stack([np.zeros_like(column), column + 1, column + 2], axis=1)
+    provenance = prov[pair[:, None], corners]
+    return Segments(
+        striker=s_idx[pair],
+        target=t_idx[pair],
+        xi=x[pair[:, None], corners],
+        kind=provenance[..., 0],
+        index=provenance[..., 1:],
+    )
+
+
+def _local_coordinates_all(striker: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """:func:`local_coordinates` of points (p, k, 3) in striker triangles (p, 3, 3): (p, k, 2)."""
+    e1 = striker[:, 1] - striker[:, 0]
+    e2 = striker[:, 2] - striker[:, 0]
+    n = _cross(e1, e2)
+    nn = np.sum(n * n, axis=-1, keepdims=True)
+    m1 = _cross(e2, n) / nn
+    m2 = _cross(n, e1) / nn
+    d = points - striker[:, None, 0]
+    # one matrix-vector product per triangle, as in local_coordinates (the same round-off)
+    return np.stack([(d @ m1[:, :, None])[..., 0], (d @ m2[:, :, None])[..., 0]], axis=-1)
+
+
+def _edge_value(x: np.ndarray, edge: int) -> np.ndarray:
+    """The value a xi_1 + b xi_2 - c of the striker's edge ``edge`` at points (..., 2)."""
+    a, b, c = STRIKER_EDGES[edge]
+    return a * x[..., 0] + b * x[..., 1] - c
+
+
+def _clip_all(tri: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`clip` (before removing repeats) of projected target triangles (p, 3, 2).
+
+    Returns the pairs whose polygon is not empty (k,), their polygons'
+    vertices (k, w, 2), their provenance (k, w, 3) and the vertex counts (k,);
+    slots past a polygon's count hold zeros.
+    """
+    n_pairs = tri.shape[0]
+    rows = np.arange(n_pairs)[:, None]
+    e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    positive = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0] > 0
+    # counter-clockwise vertex order; each polygon edge (from a vertex to the next) lies
+    # on a line: the target edge line_index (line_kind _ON_TARGET) or a striker edge
+    order = np.where(positive[:, None], np.array([0, 1, 2]), np.array([0, 2, 1]))
+    x = tri[rows, order]
+    prov = np.stack([np.full((n_pairs, 3), TARGET_VERTEX), order,
+                     np.full((n_pairs, 3), -1)], axis=-1)
+    line_kind = np.full((n_pairs, 3), _ON_TARGET)
+    line_index = np.where(positive[:, None], np.array([0, 1, 2]), np.array([2, 1, 0]))
+    count = np.full(n_pairs, 3)
+    alive = np.arange(n_pairs)
+    for edge in range(3):
+        n_pairs, width = x.shape[:2]
+        if not n_pairs:
+            break
+        rows = np.arange(n_pairs)[:, None]
+        slot = np.arange(width)[None, :]
+        valid = slot < count[:, None]
+        following = np.where(slot + 1 < count[:, None], slot + 1, 0)
+        f = _edge_value(x, edge)
+        inside = (-f if edge == 1 else f) >= -CLIP_TOL
+        inside_p = valid & inside
+        crosses = valid & (inside_p != inside[rows, following])
+        # each vertex p gives p when inside, then the crossing of its edge p-q with the
+        # striker edge when exactly one of p, q is inside
+        n_out = inside_p.astype(np.int64) + crosses
+        end = np.cumsum(n_out, axis=1)
+        start = end - n_out
+        count = end[:, -1]
+        new_width = int(count.max())
+        new_x = np.zeros((n_pairs, new_width, 2))
+        new_prov = np.zeros((n_pairs, new_width, 3), np.int64)
+        new_kind = np.zeros((n_pairs, new_width), np.int64)
+        new_index = np.zeros((n_pairs, new_width), np.int64)
+        pair, at = np.nonzero(inside_p)
+        to = start[pair, at]
+        new_x[pair, to] = x[pair, at]
+        new_prov[pair, to] = prov[pair, at]
+        new_kind[pair, to] = line_kind[pair, at]
+        new_index[pair, to] = line_index[pair, at]
+        pair, at = np.nonzero(crosses)
+        nxt = following[pair, at]
+        p, q = x[pair, at], x[pair, nxt]
+        fp, fq = f[pair, at], f[pair, nxt]
+        t = fp / (fp - fq)
+        on_target = line_kind[pair, at] == _ON_TARGET
+        k = line_index[pair, at]
+        after_p = inside_p[pair, at]
+        to = start[pair, at] + after_p
+        new_x[pair, to] = p + t[:, None] * (q - p)
+        new_prov[pair, to] = np.stack([
+            np.where(on_target, EDGE_CROSSING, STRIKER_VERTEX),
+            np.where(on_target, edge, _SHARED[k, edge]),
+            np.where(on_target, k, -1)], axis=-1)
+        # leaving the striker, the polygon goes on along the striker's edge
+        new_kind[pair, to] = np.where(after_p, _ON_STRIKER, line_kind[pair, at])
+        new_index[pair, to] = np.where(after_p, edge, k)
+        # drop the polygons clipped away
+        kept = count > 0
+        alive, count = alive[kept], count[kept]
+        x, prov = new_x[kept], new_prov[kept]
+        line_kind, line_index = new_kind[kept], new_index[kept]
+    return alive, x, prov, count
+
+
+def _without_repeats_all(x: np.ndarray, prov: np.ndarray,
+                         count: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_without_repeats` of polygons (p, w, 2) with provenance (p, w, 3) and counts (p,)."""
+    n_pairs, width = x.shape[:2]
+    rows = np.arange(n_pairs)
+    kept = np.zeros((n_pairs, width), bool)
+    last = np.zeros(n_pairs, np.int64)  # the last kept vertex (when there is one)
+    for slot in range(width):
+        step = x[:, slot] - x[rows, last]
+        close = np.sqrt(step[:, 0] * step[:, 0] + step[:, 1] * step[:, 1]) < 1e-13
+        keep = (slot < count) & ~(close & kept.any(axis=1))
+        kept[:, slot] = keep
+        last = np.where(keep, slot, last)
+    # then drop trailing vertices that repeat the first one
+    n_kept = kept.sum(axis=1)
+    position = np.cumsum(kept, axis=1) - 1
+    pair, slot = np.nonzero(kept)
+    new_x = np.zeros((n_pairs, width, 2))
+    new_prov = np.zeros((n_pairs, width, 3), np.int64)
+    new_x[pair, position[pair, slot]] = x[pair, slot]
+    new_prov[pair, position[pair, slot]] = prov[pair, slot]
+    for _ in range(width):
+        tail = new_x[rows, np.maximum(n_kept - 1, 0)] - new_x[:, 0]
+        close = np.sqrt(tail[:, 0] * tail[:, 0] + tail[:, 1] * tail[:, 1]) < 1e-13
+        drop = (n_kept > 1) & close
+        if not drop.any():
+            break
+        n_kept = n_kept - drop
+    return new_x, new_prov, n_kept
 
 
 def _largest_size(tris: np.ndarray) -> float:
@@ -331,10 +532,13 @@ __all__ = [
     "STRIKER_VERTEX",
     "TARGET_VERTEX",
     "Segments",
+    "candidate_pairs",
     "clip",
     "corner_from_provenance",
     "local_coordinates",
     "segment_pair",
+    "segment_pairs",
+    "segment_pairs_loop",
     "segment_surfaces",
     "unit_normal",
     "weighted_gaps",
