@@ -11,6 +11,8 @@ from fenics_contact.model.segments3d import (
     STRIKER_VERTEX,
     TARGET_VERTEX,
     Segments,
+    _without_repeats,
+    _without_repeats_all,
     candidate_pairs,
     clip,
     corner_from_provenance,
@@ -345,6 +347,27 @@ def test_vectorised_clipping_at_the_tolerance_and_on_the_edges() -> None:
     outside = np.minimum.reduce([expected.xi[..., 0], expected.xi[..., 1],
                                  1.0 - expected.xi.sum(axis=-1)])
     assert outside.min() < -0.4 * CLIP_TOL
+
+
+def test_repeated_vertices_are_dropped_as_one_polygon_at_a_time() -> None:
+    """Chains of vertices less than 1e-13 apart: each is compared with the last one kept,
+    and the vertices at the end that repeat the first are dropped."""
+    n_pairs, width = 3000, 7
+    base = RNG.choice([0.0, 0.3, 1.0], (n_pairs, width, 2))
+    x = base + RNG.choice([0.0, 0.6e-13, 1.2e-13, 1.8e-13], (n_pairs, width, 2))
+    x = np.where(RNG.uniform(size=(n_pairs, width, 1)) < 0.6, x[:, :1], x)  # repeat x_0
+    prov = RNG.integers(-1, 3, (n_pairs, width, 3))
+    count = RNG.integers(0, width + 1, n_pairs)
+    got_x, got_prov, got_count = _without_repeats_all(x, prov, count)
+    lengths = []
+    for p in range(n_pairs):
+        kept = _without_repeats([(x[p, k], tuple(prov[p, k])) for k in range(count[p])])
+        lengths.append(len(kept))
+        assert got_count[p] == len(kept)
+        for k, (xk, provk) in enumerate(kept):
+            np.testing.assert_array_equal(got_x[p, k], xk)
+            assert tuple(got_prov[p, k]) == provk
+    assert len(set(lengths)) == width + 1  # every length from 0 to width
 
 
 def test_no_pairs_give_no_segments() -> None:
