@@ -26,9 +26,11 @@ positions and ``ufl.derivative`` can linearise the segmentation:
 :func:`corner_from_provenance` evaluates those formulas (the same algebra
 a UFL form would hold); the tests check that it reproduces the clipped
 coordinates and that the segments tile the covered area exactly. The
-candidate pairs come from a k-d tree on the target centroids (O(n log m));
-the clipping itself is a Python loop over the pairs (fine for surfaces of a
-few thousand triangles; to be vectorised).
+candidate pairs come from a k-d tree on the target centroids (O(n log m))
+and are clipped all at once with array operations (:func:`segment_pairs`:
+fixed-width vertex buffers with a count per pair, the three striker edges
+in turn); :func:`clip` and :func:`segment_pair`, one pair at a time, are
+the reference it is tested against (:func:`segment_pairs_loop`).
 
 References: Puso and Laursen, CMAME 193 (2004) 601-629; Popp, Gee and
 Wall, IJNME 79 (2009) 1354-1391 (segment-based integration in 3D).
