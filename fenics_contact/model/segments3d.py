@@ -124,7 +124,14 @@ def _inside(point: np.ndarray, edge: int) -> float:
 
 
 def _crossing(p: np.ndarray, q: np.ndarray, edge: int) -> np.ndarray:
-    """The point of segment p-q on the line of the striker's edge ``edge``."""
+    """The point of segment p-q on the line of the striker's edge ``edge``.
+
+    The clipping asks for it only between a vertex strictly inside and one
+    outside, so it lies on the segment: a vertex inside only by CLIP_TOL is
+    its own exit or entry point (the line through it and its outside
+    neighbour may meet the edge's line far away when both are nearly
+    parallel).
+    """
     a, b, c = STRIKER_EDGES[edge]
     fp, fq = a * p[0] + b * p[1] - c, a * q[0] + b * q[1] - c
     t = fp / (fp - fq)
@@ -161,14 +168,17 @@ def clip(target_xi: np.ndarray) -> list[tuple[np.ndarray, tuple[int, int, int]]]
                 if fq >= -CLIP_TOL:
                     out_lines.append(line)
                     continue
-                out_lines.append(line)
-                x = _crossing(p, q, edge)
-                out.append((x, _crossing_provenance(line, edge)))
+                if fp >= 0.0:
+                    out_lines.append(line)
+                    x = _crossing(p, q, edge)
+                    out.append((x, _crossing_provenance(line, edge)))
+                # a vertex inside only by the tolerance is its own exit point
                 out_lines.append(("s", edge))
-            elif fq >= -CLIP_TOL:
+            elif fq >= 0.0:
                 x = _crossing(p, q, edge)
                 out.append((x, _crossing_provenance(line, edge)))
                 out_lines.append(line)
+            # entering at a vertex inside only by the tolerance: that vertex is the entry
         poly, lines = out, out_lines
     return _without_repeats(poly)
 
@@ -406,9 +416,14 @@ def _clip_all(tri: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.n
         valid = slot < count[:, None]
         following = np.where(slot + 1 < count[:, None], slot + 1, 0)
         f = _edge_value(x, edge)
-        inside = (-f if edge == 1 else f) >= -CLIP_TOL
+        signed = -f if edge == 1 else f
+        inside, strict = signed >= -CLIP_TOL, signed >= 0.0
         inside_p = valid & inside
-        crosses = valid & (inside_p != inside[rows, following])
+        inside_q, strict_q = inside[rows, following], strict[rows, following]
+        leaving = inside_p & ~inside_q
+        # a vertex inside only by the tolerance is its own exit or entry point (_crossing)
+        crosses = (leaving & strict) | (valid & ~inside_p & inside_q & strict_q)
+        own_exit = leaving & ~strict
         # each vertex p gives p when inside, then the crossing of its edge p-q with the
         # striker edge when exactly one of p, q is inside
         n_out = inside_p.astype(np.int64) + crosses
@@ -424,8 +439,9 @@ def _clip_all(tri: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.n
         to = start[pair, at]
         new_x[pair, to] = x[pair, at]
         new_prov[pair, to] = prov[pair, at]
-        new_kind[pair, to] = line_kind[pair, at]
-        new_index[pair, to] = line_index[pair, at]
+        exit_here = own_exit[pair, at]
+        new_kind[pair, to] = np.where(exit_here, _ON_STRIKER, line_kind[pair, at])
+        new_index[pair, to] = np.where(exit_here, edge, line_index[pair, at])
         pair, at = np.nonzero(crosses)
         nxt = following[pair, at]
         p, q = x[pair, at], x[pair, nxt]
