@@ -1,7 +1,9 @@
 """Mortar against node-to-segment: the cost of a Newton iteration and of the first compilation.
 
-Two identical half-cylinders (linear elastic, E = 200, nu = 0.3) pushed
-together by 0.02 in 10 steps with GNRM and MUMPS, on one mesh, once with a
+``--case cylinders`` (2D, the default): two identical half-cylinders (linear
+elastic, E = 200, nu = 0.3) pushed together by 0.02 in 10 steps;
+``--case hemispheres`` (3D): the shipped two hemispheres (quarter model) in
+4 steps at contact size ``--h``. GNRM and MUMPS, on one mesh, once with a
 node-to-segment pair and once with a mortar pair; the runs alternate
 (``--repeats`` of each, side by side in one process) and the median time per
 Newton iteration of each is compared, with the kernel's accounts (residual
@@ -14,10 +16,10 @@ is what a user waits for the first time a scene runs. ``--opt`` chooses the
 C optimisation level of the mortar forms (the library's default is the
 ``MortarContact.jit_options``).
 
-Writes ``OUT/mortar_cost.json`` and ``OUT/mortar_cost.md``.
+Writes ``OUT/mortar_cost.json`` and ``.md`` (3D: ``mortar_cost_3d``).
 
-Run: ``python benchmarks/performance/mortar_cost.py [--h 0.004] [--repeats 3] [--cold]
-[--opt 0|1|2] [--out results/bench]``.
+Run: ``python benchmarks/performance/mortar_cost.py [--case cylinders|hemispheres]
+[--h 0.004] [--repeats 3] [--cold] [--opt 0|1|2] [--out results/bench]``.
 """
 
 from __future__ import annotations
@@ -43,14 +45,21 @@ from fenics_contact.model.mortar import MortarContact
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings
 
-STEPS = 10
+STEPS = {"cylinders": 10, "hemispheres": 4}
 DISCRETISATIONS = ("node-to-segment", "mortar")
 ACCOUNTS = ("residual_s", "jacobian_s", "setup_s", "solve_s", "search_s", "transfer_s")
 
 
+CASE = "cylinders"
+
+
 def scene(h: float, discretisation: str):
-    """The two cylinders at contact size h (target 1.37 h), with the given pair."""
-    base = cases.two_cylinders(h, push=0.02, steps=STEPS, h_far=0.1)
+    """The case at contact size h, with the given pair (2D: the target's size is 1.37 h)."""
+    if CASE == "hemispheres":
+        from benchmarks.validation.mortar_hemispheres import scene_for
+
+        return scene_for(h, discretisation)
+    base = cases.two_cylinders(h, push=0.02, steps=STEPS[CASE], h_far=0.1)
     return replace(base, pairs=tuple(replace(p, discretisation=discretisation)
                                      for p in base.pairs))
 
@@ -69,8 +78,9 @@ def run(h: float, discretisation: str, first_only: bool = False) -> dict:
                                                               else 50))
     built = time.perf_counter()
     its = 0
-    for i in range(1, (1 if first_only else STEPS) + 1):
-        problem.set_load(i / STEPS)
+    steps = STEPS[CASE]
+    for i in range(1, (1 if first_only else steps) + 1):
+        problem.set_load(i / steps)
         result = strategy.solve()
         if not first_only:
             assert result.converged, (discretisation, i, result.status)
@@ -91,7 +101,8 @@ def cold(h: float, discretisation: str, opt: int | None) -> dict:
     """``run(first_only=True)`` in a child process with an empty form cache."""
     with tempfile.TemporaryDirectory() as cache:
         env = {**os.environ, "XDG_CACHE_HOME": cache}
-        argv = [sys.executable, __file__, "--child", discretisation, "--h", str(h)]
+        argv = [sys.executable, __file__, "--child", discretisation, "--h", str(h),
+                "--case", CASE]
         if opt is not None:
             argv += ["--opt", str(opt)]
         out = subprocess.run(argv, env=env, check=True, capture_output=True, text=True).stdout
@@ -102,8 +113,8 @@ def table(record: dict) -> list[str]:
     """The markdown lines of the report."""
     nts, mortar = (record["warm"][d] for d in DISCRETISATIONS)
     lines = [
-        f"# Mortar against node-to-segment: two cylinders, h = {record['h']:g}, "
-        f"GNRM, {STEPS} steps", "",
+        f"# Mortar against node-to-segment: two {CASE}, h = {record['h']:g}, "
+        f"GNRM, {STEPS[CASE]} steps", "",
         f"Mortar forms at {record['mortar_flags']}; {record['repeats']} alternating runs of "
         "each, medians.", "",
         "| pair | DOFs | Newton its | s / iteration | residual | Jacobian | LU + solve | search "
@@ -129,13 +140,19 @@ def table(record: dict) -> list[str]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--h", type=float, default=0.004)
+    parser.add_argument("--case", choices=tuple(STEPS), default="cylinders")
+    parser.add_argument("--h", type=float, default=None,
+                        help="contact size (default 0.004 cylinders, 0.01 hemispheres)")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--opt", type=int, default=None, choices=(0, 1, 2, 3))
     parser.add_argument("--cold", action="store_true", help="also time an empty form cache")
     parser.add_argument("--child", default=None, help=argparse.SUPPRESS)
     parser.add_argument("--out", type=Path, default=Path("results/bench"))
     args = parser.parse_args()
+    global CASE
+    CASE = args.case
+    if args.h is None:
+        args.h = 0.004 if CASE == "cylinders" else 0.01
     set_mortar_optimisation(args.opt)
     if args.child:
         print(json.dumps(run(args.h, args.child, first_only=True)))
@@ -160,9 +177,11 @@ def main() -> None:
         record["cold"] = {d: cold(args.h, d, args.opt) for d in DISCRETISATIONS}
     if MPI.COMM_WORLD.rank == 0:
         args.out.mkdir(parents=True, exist_ok=True)
-        (args.out / "mortar_cost.json").write_text(json.dumps(record, indent=2))
+        name = "mortar_cost" if CASE == "cylinders" else "mortar_cost_3d"
+        record["case"] = CASE
+        (args.out / f"{name}.json").write_text(json.dumps(record, indent=2))
         lines = table(record)
-        (args.out / "mortar_cost.md").write_text("\n".join(lines) + "\n")
+        (args.out / f"{name}.md").write_text("\n".join(lines) + "\n")
         print("\n".join(lines))
 
 

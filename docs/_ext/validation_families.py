@@ -112,6 +112,33 @@ def _mortar_figure(data: dict) -> Figure:
     return fig
 
 
+def _hemispheres_table(data: dict) -> Rows:
+    header = ["h", "pair", "DOFs", "status", "Newton", "a fit vs Hertz", "p0 fit vs Hertz",
+              "largest nodal p vs p0", "L2 r < a - 2h", "solve s"]
+    rows = [[r["h"], r["discretisation"], r["u_dofs"], r["status"], r["iterations"],
+             r["a_error"], r["p0_fit_error"], r["peak_error"], r["l2_inside"], r["solve_s"]]
+            for r in data["runs"]]
+    return header, rows
+
+
+def _hemispheres_figure(data: dict) -> Figure:
+    fig, (left, right) = plt.subplots(1, 2, figsize=(10, 3.6))
+    for kind, marker in (("node-to-segment", "s"), ("mortar", "o")):
+        runs = sorted((r for r in data["runs"] if r["discretisation"] == kind),
+                      key=lambda r: r["h"])
+        h = [r["h"] for r in runs]
+        left.loglog(h, [abs(r["peak_error"]) for r in runs], marker + "-", label=kind)
+        right.loglog(h, [r["l2_inside"] for r in runs], marker + "-", label=kind)
+    left.set_ylabel("|largest nodal pressure / p0 - 1|")
+    right.set_ylabel("relative L2 error, r < a - 2h")
+    for ax in (left, right):
+        ax.set_xlabel("contact element size h / R")
+        ax.legend(fontsize=8)
+    fig.suptitle("Two hemispheres on non-matching tetrahedra against Hertz")
+    fig.tight_layout()
+    return fig
+
+
 def _cattaneo_table(data: dict) -> Rows:
     header = ["mesh", "Q/(mu P)", "c/a measured", "c/a analytic", "c error",
               "half node spacing / c", "traction L2 error"]
@@ -152,6 +179,15 @@ FAMILIES: dict[str, Family] = {
         "On non-matching meshes the one-pass node-to-segment pressures scatter node to "
         "node and their error does not fall with h; inside the zone the mortar pair's "
         "error falls with h (the whole-zone L2 error also holds the edge of the zone).",
+    ),
+    "mortar_hemispheres": Family(
+        "Two hemispheres (3D): mortar and node-to-segment pairs", _hemispheres_table,
+        _hemispheres_figure,
+        "The shipped quarter model on non-matching tetrahedra. The node-to-segment nodal "
+        "pressures scatter (the largest 7-17 % above p0) while the fitted radius and peak "
+        "stay close; the mortar pair's nodal pressures are smooth, the largest within 1.5 % "
+        "of p0 on the finest mesh, in the same Newton iterations. The L2 error levels off "
+        "near 3.6 %: the tetrahedra, not the pair, then limit it.",
     ),
     "cattaneo_mindlin": Family(
         "Cattaneo-Mindlin partial slip", _cattaneo_table, _cattaneo_figure,
