@@ -116,10 +116,17 @@ class MortarTransfer3D:
 
     # -- search and nodal gaps -------------------------------------------------------
     def _forms(self, which: str, k: int) -> SegmentForms:
-        """The segment mesh ``which`` ('all' or 'near'), large enough for k segments."""
+        """The segment mesh ``which`` ('all', 'near', 'loaded'), large enough for k segments."""
         forms = self._segment_forms.get(which)
-        if forms is None or k > forms.capacity:
-            capacity = max(self._capacity if which == "all" else 16, 2 * k)
+        if which == "all":
+            if forms is None or k > forms.capacity:
+                capacity = max(self._capacity, 2 * k)
+                forms = self._segment_forms[which] = SegmentForms(capacity, dual=True)
+            return forms
+        # the derivative meshes are assembled whole, unused cells included: keep them
+        # within 25 % of the segments they hold (a new mesh reuses the compiled forms)
+        if forms is None or k > forms.capacity or forms.capacity > 2 * max(k, 16):
+            capacity = max(16, int(1.25 * k) + 1)
             forms = self._segment_forms[which] = SegmentForms(capacity, dual=True)
         return forms
 
@@ -178,6 +185,7 @@ class MortarTransfer3D:
         near_forms.fill(vertices[near], provenance[near])
         near_forms.set_dual(theta[near])
         self._corner_vertex, self._segment_dofs = corner_vertex[near], segment_dofs[near]
+        self._near_data = (vertices[near], provenance[near], theta[near])
         dg = self._gathered_rows("gap_tangent")
         dA = self._gathered_rows("weight_tangent")
         scale = np.where(engaged, inv, 0.0)
@@ -216,14 +224,21 @@ class MortarTransfer3D:
         c = self.comm.allreduce(c)
         a = c * self._inv
         b = -a * np.where(self.covered, self.values, 0.0)
-        forms = self._segment_forms["near"]
-        forms.set_corner_weights(a[self._corner_vertex], b[self._corner_vertex])
+        # only segments with a loaded corner (c_j != 0: the active nodes) contribute
+        vertices, provenance, theta = self._near_data
+        loaded = np.flatnonzero(np.any(a[self._corner_vertex] != 0.0, axis=1))
+        forms = self._forms("loaded", loaded.size)
+        forms.fill(vertices[loaded], provenance[loaded])
+        forms.set_dual(theta[loaded])
+        corners = self._corner_vertex[loaded]
+        forms.set_corner_weights(a[corners], b[corners])
         H = forms.assemble_matrix("hessian").tocoo()
         _, (rows18, pos) = forms.cell_dofs()
         keep = rows18[H.row] < forms.count
         r, cc, v = H.row[keep], H.col[keep], H.data[keep]
-        rows = [self._segment_dofs[rows18[r], pos[r]]]
-        cols = [self._segment_dofs[rows18[cc], pos[cc]]]
+        dofs = self._segment_dofs[loaded]
+        rows = [dofs[rows18[r], pos[r]]]
+        cols = [dofs[rows18[cc], pos[cc]]]
         vals = [v]
         # the rank-one terms of the nodes this rank owns
         own = self.q_vertex[: self.n_owned]

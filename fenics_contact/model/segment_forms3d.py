@@ -45,6 +45,10 @@ from fenics_contact.model.segments3d import REFERENCE, STRIKER_EDGES, Segments
 #: Columns of a corner's provenance row: kind (3), striker corner (3), target
 #: vertex (3), striker edge (3), target edge (3).
 KIND, CORNER, VERTEX, EDGE, TARGET_EDGE = 0, 3, 6, 9, 12
+#: C optimisation of the second-derivative kernel: gcc takes about 8 s at -O0 and
+#: 170 s at -O1 on it (2-core machine); -O1 assembles it 2.3 times faster, but it
+#: is assembled only on the segments of engaged nodes (docs/two_bodies.md).
+HESSIAN_OPT = "-O0"
 #: A pair of triangles that keeps every formula finite in unused cells.
 _DUMMY = np.vstack([np.column_stack([REFERENCE, np.zeros(3)]),
                     np.column_stack([REFERENCE[::-1], np.ones(3)])])
@@ -117,11 +121,12 @@ class SegmentForms:
         self.fill(np.zeros((0, 6, 3)), np.zeros((0, 3, 15)))
 
     def compiled(self) -> dict[str, fem.Form]:
-        """The five forms compiled (once; cheap C optimisation, the Hessian kernel is large)."""
+        """The five forms compiled (once; the large Hessian kernel at HESSIAN_OPT)."""
         if self._compiled is None:
-            options = {"cffi_extra_compile_args": ["-O1", "-g0"]}
             self._compiled = {
-                name: fem.form(getattr(self, f"{name}_form"), jit_options=options)
+                name: fem.form(getattr(self, f"{name}_form"), jit_options={
+                    "cffi_extra_compile_args": [HESSIAN_OPT if name == "hessian" else "-O1",
+                                                "-g0"]})
                 for name in ("gap", "weight", "gap_tangent", "weight_tangent", "hessian")
             }
         return self._compiled
