@@ -52,6 +52,7 @@ from fenics_contact.model.segments import (
     overlaps,
     pick_slots,
 )
+from fenics_contact.model.variational_system import Transfers
 
 _GAUSS = ((0.5 - 0.5 / np.sqrt(3.0), 0.5), (0.5 + 0.5 / np.sqrt(3.0), 0.5))
 
@@ -314,13 +315,17 @@ class MortarContact(Contact):
         if solid.gdim == 3:
             from fenics_contact.model.mortar3d import MortarTransfer3D
 
-            if self.friction_settings is not None:
-                raise ValueError("Coulomb friction on 3D mortar pairs is not available in this "
-                                 "version; use discretisation = \"node-to-segment\" for a "
-                                 "frictional 3D pair.")
             self.mortar = MortarTransfer3D(solid.V, solid.u, self.surface, self.target_facets,
                                            self.surface.h, self.lam)
             self.mortar.refresh()
+            if self.friction_settings is not None:
+                # the slip of each striker node at its projection (node-to-segment)
+                from fenics_contact.model.pairs import DeformablePair
+
+                self.slip_pair = DeformablePair(solid.V, solid.u, self.surface,
+                                                self.target_facets)
+                self.slip_pair.refresh()
+                self._transfer = Transfers([self.mortar, self.slip_pair])
             return self.mortar.G
         self.mortar = MortarTransfer(solid.V, solid.u, self.surface, self.target_facets,
                                      self._slots)
@@ -331,29 +336,48 @@ class MortarContact(Contact):
         self.open_gap = fem.Constant(solid.domain, default_scalar_type(self.surface.h))
         return self.mortar.nodal_gap(X, X + solid.u, self.open_gap)
 
-    def refresh(self) -> bool:
-        """Search the slots and refill the coefficients when u has changed."""
-        return self.mortar.refresh()
-
     def slip_increment(self, u_prev: fem.Function) -> tuple[ufl.core.expr.Expr, ufl.core.expr.Expr]:
-        """(T_j, s~_j): the weighted slip on the segments (:mod:`.mortar_friction`)."""
+        """(T_j, s~_j) of the Coulomb terms.
+
+        2D: the weighted slip on the segments (:mod:`.mortar_friction`); 3D: the
+        slip of the striker node at its projection on the target (node-to-segment).
+        """
+        if self.gdim == 3:
+            from fenics_contact.model.pairs import slip_at_projection
+
+            return slip_at_projection(self.slip_pair, self.solid.u, u_prev, self.gdim)
         w_prev = self.mortar.track_previous(u_prev)
         X = ufl.SpatialCoordinate(self.domain)
         return mortar_slip(self.mortar, X, self.solid.u, u_prev, w_prev)
 
     def commit_frame(self) -> None:
-        """w_prev <- the stencil rows of the new u_prev."""
-        if self.friction is not None:
+        """The previous frame <- the new u_prev (2D stencil rows; 3D the projections' vertices)."""
+        if self.friction is None:
+            return
+        if self.gdim == 3:
+            self.slip_pair.set_previous()
+        else:
             self.mortar.set_previous()
 
     def extras(self) -> list[fem.Function]:
-        """2D: the packed neighbour and slot displacements (w = S u); 3D: the nodal gaps G."""
-        return [self.mortar.G] if self.gdim == 3 else [self.mortar.w]
+        """The extras the kernel condenses.
+
+        2D: the packed neighbour and slot displacements (w = S u); 3D: the nodal
+        gaps G and, with friction, the projections' target vertex displacements.
+        """
+        if self.gdim == 3:
+            slip = list(self.slip_pair.w) if self.friction_settings is not None else []
+            return [self.mortar.G, *slip]
+        return [self.mortar.w]
 
     @property
     def transfer(self):
         """The search and condensation (refresh, version, sources or condensation)."""
-        return self.mortar
+        return getattr(self, "_transfer", self.mortar)
+
+    def refresh(self) -> bool:
+        """Search and refill the coefficients when u has changed."""
+        return self.transfer.refresh()
 
     def target_force(self) -> fem.Function:
         """Contact force on the target's vertices, S^T dL_c/dw over the slot rows (force)."""
@@ -396,7 +420,7 @@ class MortarContact(Contact):
         if self._target_force_forms is None:
             form = ufl.derivative(self.lagrangian(), m.G, ufl.TestFunction(self.Q))
             self._target_force_forms = [fem.form(form, entity_maps=self.surface.entity_maps)]
-        m.refresh()
+        self.refresh()
         local = fem.assemble_vector(self._target_force_forms[0])
         local.scatter_reverse(la.InsertMode.add)
         force = m.target_force(local.array[: m.n_owned])
@@ -404,8 +428,36 @@ class MortarContact(Contact):
         lo, hi = V.dofmap.index_map.local_range
         out = fem.Function(V, name="target_contact_force")
         out.x.array[: (hi - lo) * 3] = force[3 * lo : 3 * hi]
+        if self.friction is not None:
+            out.x.array[: (hi - lo) * 3] += self._friction_target_force()
         out.x.scatter_forward()
         return out
+
+    def _friction_target_force(self) -> np.ndarray:
+        """-S^T dW_t/dw of the projections' target vertices, owned V dofs (3D friction)."""
+        from petsc4py import PETSc
+
+        pair = self.slip_pair
+        if getattr(self, "_friction_forms", None) is None:
+            q = ufl.TestFunction(pair.W)
+            self._friction_forms = [
+                fem.form(self.friction.work(self.friction.traction_t, wk, q),
+                         entity_maps=self.surface.entity_maps) for wk in pair.w]
+        V = self.solid.V
+        im = V.dofmap.index_map
+        vec = PETSc.Vec().createMPI((im.size_local * 3, im.size_global * 3), bsize=3,
+                                    comm=self.comm)
+        vec.set(0.0)
+        for form, src in zip(self._friction_forms, pair.sources(), strict=True):
+            local = fem.assemble_vector(form)
+            local.scatter_reverse(la.InsertMode.add)
+            vec.setValuesBlocked(src.astype(PETSc.IntType), local.array[: pair.n_owned * 3],
+                                 addv=PETSc.InsertMode.ADD)
+        vec.assemblyBegin()
+        vec.assemblyEnd()
+        values = -vec.getArray(readonly=True).copy()
+        vec.destroy()
+        return values
 
 
 __all__ = ["MortarContact", "MortarTransfer"]

@@ -355,27 +355,8 @@ class NodeToSegmentContact(Contact):
 
     # -- friction -----------------------------------------------------------------------
     def slip_increment(self, u_prev: fem.Function) -> tuple[ufl.core.expr.Expr, ufl.core.expr.Expr]:
-        """T of the target facet and the relative slip of the contacting points.
-
-        dg_t = T^T [(x_s - x_s_prev) - (x_p - x_p_prev)] with x_p = sum_k N_k x_k
-        at the current projection (same xi then and now), so the reference
-        positions cancel: dg_t = T^T [(u - u_prev) - sum_k N_k (w_k - w_k_prev)].
-        w_k_prev, the previous displacements of the assigned vertices, are
-        data filled by the search from u_prev. Under a common rigid
-        translation dg_t = 0 and its derivative vanishes, so the friction
-        forces on the striker and on the target balance exactly.
-        """
-        pair = self.pair
-        w_prev = pair.track_previous(u_prev)
-        u = self.solid.u
-        x_s = ufl.SpatialCoordinate(self.domain) + u
-        tangents = tangent_basis(pair.normal(), self.gdim)
-        target = sum(
-            (N * (wk - wk_prev)
-             for N, wk, wk_prev in zip(pair.shape_weights(x_s), pair.w, w_prev, strict=True)),
-            ufl.zero(self.gdim),
-        )
-        return tangents, tangents.T * ((u - u_prev) - target)
+        """T of the target facet and the relative slip (:func:`slip_at_projection`)."""
+        return slip_at_projection(self.pair, self.solid.u, u_prev, self.gdim)
 
     def commit_frame(self) -> None:
         """w_k_prev <- the assigned vertices' displacements in the new u_prev."""
@@ -421,6 +402,29 @@ class NodeToSegmentContact(Contact):
         out.x.scatter_forward()
         vec.destroy()
         return out
+
+
+def slip_at_projection(pair: DeformablePair, u: fem.Function, u_prev: fem.Function,
+                       gdim: int) -> tuple[ufl.core.expr.Expr, ufl.core.expr.Expr]:
+    """T of the target facet and the relative slip of a striker node and its projection.
+
+    dg_t = T^T [(x_s - x_s_prev) - (x_p - x_p_prev)] with x_p = sum_k N_k x_k
+    at the current projection (same xi then and now), so the reference
+    positions cancel: dg_t = T^T [(u - u_prev) - sum_k N_k (w_k - w_k_prev)].
+    w_k_prev, the previous displacements of the assigned vertices, are data
+    filled by the search from u_prev. Under a common rigid translation
+    dg_t = 0 and its derivative vanishes, so the friction forces on the
+    striker and on the target balance exactly.
+    """
+    w_prev = pair.track_previous(u_prev)
+    x_s = ufl.SpatialCoordinate(u.function_space.mesh) + u
+    tangents = tangent_basis(pair.normal(), gdim)
+    target = sum(
+        (N * (wk - wk_prev)
+         for N, wk, wk_prev in zip(pair.shape_weights(x_s), pair.w, w_prev, strict=True)),
+        ufl.zero(gdim),
+    )
+    return tangents, tangents.T * ((u - u_prev) - target)
 
 
 def bind_pair_bodies(contact: Contact, solid) -> None:

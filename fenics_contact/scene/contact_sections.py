@@ -181,13 +181,10 @@ def read_pairs(path: Path, data: dict[str, Any], dimension: int = 2) -> tuple[Pa
 
 
 def _discretisation(reader: _Reader, dim: int) -> str:
-    """[[pair]] discretisation: "node-to-segment" (default) or "mortar" (2D; 3D frictionless)."""
+    """[[pair]] discretisation: "node-to-segment" (default) or "mortar"."""
     value = reader.table.get("discretisation", "node-to-segment")
     if value not in ("node-to-segment", "mortar"):
         raise reader.fail("discretisation", 'choose "node-to-segment" (the default) or "mortar".')
-    if value == "mortar" and dim == 3 and "mu" in reader.table:
-        raise reader.fail("discretisation", "mortar pairs in 3D are frictionless in this "
-                          'version; use "node-to-segment" for a frictional 3D pair, or drop mu.')
     if value == "mortar" and reader.flag("self_contact", False):
         raise reader.fail("discretisation", "mortar pairs two bodies; a self-contact pair is "
                           '"node-to-segment".')

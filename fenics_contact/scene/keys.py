@@ -218,8 +218,8 @@ KEY_DOCS: dict[str, dict[str, KeyDoc]] = {
                                 "facet sizes, that a node does not search.", "facet sizes",
                                 field="PairSpec.neighbourhood"),
         "discretisation": KeyDoc('"node-to-segment" | "mortar"', "Node-to-segment, or mortar "
-                                 "(exact on non-matching meshes; 2D with or without friction, "
-                                 "3D frictionless).",
+                                 "(exact on non-matching meshes; 2D and 3D, with or without "
+                                 "friction).",
                                  field="PairSpec.discretisation"),
     },
     "pairing": {

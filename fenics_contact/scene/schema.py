@@ -56,7 +56,7 @@ Deformable bodies in one mesh replace [material] and [contact] by::
                  defaults to striker; one [[body]] is then enough), neighbourhood
                  (facet sizes along the surface a node does not search; default 3)
                  discretisation = "node-to-segment" (default) | "mortar"
-                 (exact on non-matching meshes; 2D with or without mu, 3D without)
+                 (exact on non-matching meshes; 2D and 3D, with or without mu)
     [[obstacle]] as above, its tag on the facets of one body
 
 In every scene a [[dirichlet]] may give path = [[t, ux, uy], ...] (a
