@@ -72,6 +72,18 @@ def write(name: str, data: dict, table: str, out: Path = OUT) -> None:
     (out / f"{name}.md").write_text(table.rstrip() + "\n")
 
 
+def report(name: str, runs: Sequence[dict], header: Sequence[str], columns: Sequence[str],
+           out: Path = OUT, drop: Sequence[str] = ()) -> str:
+    """Tabulate ``columns`` of each run, write ``<out>/<name>.json``/``.md``; return the table.
+
+    ``drop``: keys of the runs (long profiles) left out of the JSON.
+    """
+    table = md_table(header, [[r[c] for c in columns] for r in runs])
+    summary = [{k: v for k, v in r.items() if k not in drop} for r in runs]
+    write(name, {"machine": machine(), "runs": summary}, table, out)
+    return table
+
+
 def md_table(header: Sequence[str], rows: Sequence[Sequence[object]]) -> str:
     """A markdown table; floats to 4 significant digits."""
 

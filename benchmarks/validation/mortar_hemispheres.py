@@ -30,7 +30,7 @@ import numpy as np
 from mpi4py import MPI
 
 import fenics_contact  # noqa: F401  (the DOLFINx wheel first)
-from benchmarks.harness import machine, md_table, write
+from benchmarks.harness import report
 from fenics_contact import build_problem, load_scene, make_strategy, solve_load_path
 from fenics_contact.references.hertz import fit_contact_profile
 from fenics_contact.references.hertz3d import hertz_point_contact
@@ -119,13 +119,14 @@ def main() -> None:
     runs = [solve(h, d) for h in sizes for d in DISCRETISATIONS]
     if MPI.COMM_WORLD.rank != 0:
         return
-    rows = [(r["h"], r["discretisation"], r["u_dofs"], r["status"], r["iterations"],
-             r["a_error"], r["p0_fit_error"], r["peak_error"], r["l2_inside"],
-             round(r["solve_s"], 1)) for r in runs]
-    table = md_table(["h", "pair", "DOFs", "status", "Newton", "a (fit)", "p0 (fit)",
-                      "nodal peak", "L2 r < a - 2h", "solve s"], rows)
-    summary = [{k: v for k, v in r.items() if k not in ("r", "p")} for r in runs]
-    write("mortar_hemispheres", {"machine": machine(), "runs": summary}, table, args.out)
+    for run in runs:
+        run["solve_s"] = round(run["solve_s"], 1)
+    table = report("mortar_hemispheres", runs,
+                   ["h", "pair", "DOFs", "status", "Newton", "a (fit)", "p0 (fit)",
+                    "nodal peak", "L2 r < a - 2h", "solve s"],
+                   ["h", "discretisation", "u_dofs", "status", "iterations", "a_error",
+                    "p0_fit_error", "peak_error", "l2_inside", "solve_s"], args.out,
+                   drop=("r", "p"))
     print(table)
     if args.figure is not None:
         picture(runs, min(sizes), args.figure)

@@ -29,7 +29,7 @@ from mpi4py import MPI
 
 import fenics_contact  # noqa: F401  (the DOLFINx wheel first)
 from benchmarks.cases import two_cylinders
-from benchmarks.harness import machine, md_table, write
+from benchmarks.harness import report
 from fenics_contact import build_problem, make_strategy, solve_load_path
 from fenics_contact.references.hertz import hertz_line_contact
 from fenics_contact.solvers.diagnostics import SolverSettings
@@ -107,12 +107,10 @@ def main() -> None:
     runs = [solve(h, d) for h in sizes for d in DISCRETISATIONS]
     if MPI.COMM_WORLD.rank != 0:
         return
-    rows = [(r["h"], r["discretisation"], r["status"], r["iterations"], r["peak_error"],
-             r["l2_whole"], r["l2_inside"]) for r in runs]
-    table = md_table(["h", "pair", "status", "Newton", "peak vs p0", "L2 |x| < 1.5 a",
-                      "L2 |x| < a - 2h"], rows)
-    summary = [{k: v for k, v in r.items() if k not in ("x", "p")} for r in runs]
-    write("mortar_hertz", {"machine": machine(), "runs": summary}, table, args.out)
+    table = report("mortar_hertz", runs, ["h", "pair", "status", "Newton", "peak vs p0",
+                                          "L2 |x| < 1.5 a", "L2 |x| < a - 2h"],
+                   ["h", "discretisation", "status", "iterations", "peak_error", "l2_whole",
+                    "l2_inside"], args.out, drop=("x", "p"))
     print(table)
     if args.figure is not None:
         picture(runs, 0.01 if 0.01 in sizes else sizes[0], args.figure)

@@ -26,7 +26,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 import numpy as np
 
 import fenics_contact  # noqa: F401  (the DOLFINx wheel first)
-from benchmarks.harness import machine, md_table, write
+from benchmarks.harness import report
 from fenics_contact import build_problem, load_scene, make_strategy, solve_load_path
 from fenics_contact.solvers.diagnostics import SolverSettings
 
@@ -86,12 +86,10 @@ def main() -> None:
     parser.add_argument("--figure", type=Path, default=None)
     args = parser.parse_args()
     runs = [solve(dim, d) for dim in SCENES for d in DISCRETISATIONS]
-    rows = [(r["dimension"], r["discretisation"], r["status"], r["iterations"], r["spread"],
-             r["force_error"]) for r in runs]
-    table = md_table(["", "pair", "status", "Newton", "pressure spread / exact",
-                      "force error"], rows)
-    summary = [{k: v for k, v in r.items() if k not in ("x", "p")} for r in runs]
-    write("mortar_patch", {"machine": machine(), "runs": summary}, table, args.out)
+    table = report("mortar_patch", runs, ["", "pair", "status", "Newton",
+                                          "pressure spread / exact", "force error"],
+                   ["dimension", "discretisation", "status", "iterations", "spread",
+                    "force_error"], args.out, drop=("x", "p"))
     print(table)
     if args.figure is not None:
         picture(runs, args.figure)

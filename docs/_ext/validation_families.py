@@ -94,7 +94,8 @@ def _mortar_table(data: dict) -> Rows:
     return header, rows
 
 
-def _mortar_figure(data: dict) -> Figure:
+def _peak_l2_figure(data: dict, region: str, title: str) -> Figure:
+    """Largest nodal pressure error and L2 error against h, both pairs."""
     fig, (left, right) = plt.subplots(1, 2, figsize=(10, 3.6))
     for kind, marker in (("node-to-segment", "s"), ("mortar", "o")):
         runs = sorted((r for r in data["runs"] if r["discretisation"] == kind),
@@ -103,13 +104,18 @@ def _mortar_figure(data: dict) -> Figure:
         left.loglog(h, [abs(r["peak_error"]) for r in runs], marker + "-", label=kind)
         right.loglog(h, [r["l2_inside"] for r in runs], marker + "-", label=kind)
     left.set_ylabel("|largest nodal pressure / p0 - 1|")
-    right.set_ylabel("relative L2 error, |x| < a - 2h")
+    right.set_ylabel(f"relative L2 error, {region}")
     for ax in (left, right):
         ax.set_xlabel("contact element size h / R")
         ax.legend(fontsize=8)
-    fig.suptitle("Two cylinders on non-matching meshes against Hertz")
+    fig.suptitle(title)
     fig.tight_layout()
     return fig
+
+
+def _mortar_figure(data: dict) -> Figure:
+    return _peak_l2_figure(data, "|x| < a - 2h",
+                           "Two cylinders on non-matching meshes against Hertz")
 
 
 def _patch_table(data: dict) -> Rows:
@@ -143,21 +149,8 @@ def _hemispheres_table(data: dict) -> Rows:
 
 
 def _hemispheres_figure(data: dict) -> Figure:
-    fig, (left, right) = plt.subplots(1, 2, figsize=(10, 3.6))
-    for kind, marker in (("node-to-segment", "s"), ("mortar", "o")):
-        runs = sorted((r for r in data["runs"] if r["discretisation"] == kind),
-                      key=lambda r: r["h"])
-        h = [r["h"] for r in runs]
-        left.loglog(h, [abs(r["peak_error"]) for r in runs], marker + "-", label=kind)
-        right.loglog(h, [r["l2_inside"] for r in runs], marker + "-", label=kind)
-    left.set_ylabel("|largest nodal pressure / p0 - 1|")
-    right.set_ylabel("relative L2 error, r < a - 2h")
-    for ax in (left, right):
-        ax.set_xlabel("contact element size h / R")
-        ax.legend(fontsize=8)
-    fig.suptitle("Two hemispheres on non-matching tetrahedra against Hertz")
-    fig.tight_layout()
-    return fig
+    return _peak_l2_figure(data, "r < a - 2h",
+                           "Two hemispheres on non-matching tetrahedra against Hertz")
 
 
 def _cattaneo_table(data: dict) -> Rows:
