@@ -1,0 +1,97 @@
+"""Time to the first Newton iteration of every shipped scene, on an empty and a warm form cache.
+
+Each run is a fresh process (as ``fenics-contact run``): import, read the
+scene, mesh it, build the problem and its forms, and solve until the first
+Newton iteration of the first load step has finished (then the run is
+stopped). ``cold``: ``XDG_CACHE_HOME`` points at a new, empty directory, so
+every form is compiled (FFCx and the C compiler); ``warm``: the same cache
+again (median of ``--repeats``). Writes ``OUT/first_iteration.json`` and
+``.md``.
+
+Run: ``python benchmarks/performance/first_iteration.py [--repeats 2]
+[--scenes two_hemispheres_3d,block_on_block_3d] [--out results/bench]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+
+from benchmarks import harness
+
+ROOT = Path(__file__).resolve().parents[2]
+
+CHILD = """
+import json, sys, time, tempfile
+start = time.perf_counter()
+import fenics_contact
+from fenics_contact.runner import run_scene
+from fenics_contact.scene.schema import load_scene
+imported = time.perf_counter() - start
+
+class First(Exception):
+    pass
+
+def observer(iteration, norm):
+    if iteration >= 1:
+        raise First
+
+try:
+    with tempfile.TemporaryDirectory() as out:
+        run_scene(load_scene({scene!r}), __import__("pathlib").Path(out), on_residual=observer,
+                  pictures=False)
+    status = "finished before"
+except First:
+    status = "first iteration"
+print(json.dumps({{"import_s": imported, "first_iteration_s": time.perf_counter() - start,
+                  "status": status}}))
+"""
+
+
+def once(scene: Path, cache: str) -> dict:
+    """One run in a fresh process with ``XDG_CACHE_HOME=cache``."""
+    env = dict(os.environ, XDG_CACHE_HOME=cache)
+    out = subprocess.run([sys.executable, "-c", CHILD.format(scene=str(scene))], env=env,
+                         capture_output=True, text=True, check=False)
+    if out.returncode != 0:
+        return {"first_iteration_s": float("nan"), "status": "failed: "
+                + (out.stderr.strip().splitlines() or ["?"])[-1]}
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def main() -> None:
+    """Cold and warm, scene after scene."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=2)
+    parser.add_argument("--scenes", default=None, help="comma-separated names (default: all)")
+    parser.add_argument("--out", type=Path, default=harness.OUT)
+    args = parser.parse_args()
+    names = (args.scenes.split(",") if args.scenes
+             else sorted(p.stem for p in (ROOT / "scenes").glob("*.toml")))
+    runs = []
+    for name in names:
+        scene = ROOT / "scenes" / f"{name}.toml"
+        with tempfile.TemporaryDirectory() as cache:
+            cold = once(scene, cache)
+            warm = [once(scene, cache) for _ in range(args.repeats)]
+        warm_s = statistics.median(w["first_iteration_s"] for w in warm)
+        runs.append({"scene": name, "cold_s": round(cold["first_iteration_s"], 1),
+                     "warm_s": round(warm_s, 2), "import_s": round(cold.get("import_s", 0), 2),
+                     "status": cold["status"]})
+        print(runs[-1], flush=True)
+    table = harness.report("first_iteration", runs,
+                           ["scene", "cold s", "warm s (median)", "import s", "status"],
+                           ["scene", "cold_s", "warm_s", "import_s", "status"], args.out)
+    print(table)
+
+
+if __name__ == "__main__":
+    main()
