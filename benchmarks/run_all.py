@@ -1,7 +1,7 @@
 """Run every benchmark in sequence (one process per case) and gather the tables.
 
 ``python benchmarks/run_all.py [--quick]
-[--only hertz2d,cost,predict,compile,hertz3d,ladder,mpi,speedup]``.
+[--only hertz2d,cost,predict,compile,first,mortar,hertz3d,ladder,mpi,speedup]``.
 The ladder's large sizes take minutes each; ``--quick`` stops at 1e5 DOFs.
 Serial and 2-rank runs of a size are run one after the other, on a machine
 that others may be using: compare them side by side, not across days.
@@ -50,7 +50,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--only",
-                        default="hertz2d,cost,predict,compile,hertz3d,ladder,mpi,speedup")
+                        default="hertz2d,cost,predict,compile,first,mortar,hertz3d,ladder,mpi,"
+                                "speedup")
     args = parser.parse_args()
     parts = set(args.only.split(","))
     limit = 1e5 if args.quick else 1e6
@@ -62,6 +63,13 @@ def main() -> None:
         call([PYTHON, str(HERE / "performance" / "active_set_prediction.py")])
     if "compile" in parts:
         call([PYTHON, str(HERE / "performance" / "compile_cost.py")])
+    if "first" in parts:
+        call([PYTHON, str(HERE / "performance" / "first_iteration.py")])
+    if "mortar" in parts:
+        call([PYTHON, str(HERE / "performance" / "mortar_cost.py")])
+        call([PYTHON, str(HERE / "performance" / "mortar_cost.py"), "--case", "hemispheres"])
+        call([PYTHON, str(HERE / "validation" / "mortar_patch.py")])
+        call([PYTHON, str(HERE / "validation" / "mortar_hemispheres.py")])
     if "hertz3d" in parts:
         call([PYTHON, str(HERE / "validation" / "hertz3d.py")])
     for dofs, solver, ranks, repeats in LADDER:
