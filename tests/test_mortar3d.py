@@ -201,3 +201,29 @@ def test_mortar3d_hemispheres_slide_with_friction() -> None:
     other, other_path = run(10.0, "auto")
     assert other_path.converged
     assert other.contact_state().contact_force == pytest.approx(state.contact_force, rel=1e-10)
+
+
+def test_mortar3d_answer_independent_of_r_and_of_the_load_path() -> None:
+    """Two hemispheres (h = 0.03 R): the same displacement for every r and in 1 or 4 steps.
+
+    Measured: GNRM at r = 1e-2, 1 and 10 E/h the same u to 2e-15 (GNRM cycles at 1e2 E/h;
+    ``auto`` there and at 1e4 E/h gives the same force to round-off); 1 step instead of 4:
+    4e-11 (the nodal rule: no path dependence beyond the tolerance).
+    """
+    from benchmarks.validation.mortar_hemispheres import scene_for
+    from fenics_contact import build_problem, solve_load_path
+
+    def run(r: float, steps: int, method: str = "gnrm"):
+        scene = with_contact_settings(scene_for(0.03, "mortar"), r, relative=True)
+        problem = build_problem(scene)
+        strategy = make_strategy(method, problem, SolverSettings(atol=1e-11, rtol=1e-13))
+        path = solve_load_path(strategy, steps, max_cutbacks=0)
+        assert path.converged, (r, steps, method, path.status)
+        return problem.u.x.array.copy(), problem.contact_state().contact_force
+
+    reference, force = run(1.0, 4)
+    scale = np.max(np.abs(reference))
+    for r in (1e-2, 10.0):
+        assert np.max(np.abs(run(r, 4)[0] - reference)) <= 1e-10 * scale, r
+    assert run(100.0, 4, "auto")[1] == pytest.approx(force, rel=1e-10)
+    assert np.max(np.abs(run(1.0, 1)[0] - reference)) <= 1e-8 * scale
