@@ -47,6 +47,8 @@ def _summary(scene: Scene, record: RunRecord) -> dict:
         "mu": scene.contact.mu,
         "predictor": scene.solver.predictor,
         "linear_solver": scene.solver.linear_solver,
+        "forcing": scene.solver.forcing,
+        "reuse_preconditioner": scene.solver.reuse_preconditioner,
         "load_steps": scene.solver.steps,
         **record.to_dict(),
         "pairs": [
@@ -120,7 +122,10 @@ def run_scene(
     problem = build_problem(scene, comm)
     strategy = make_strategy(
         scene.solver.method, problem, scene.solver,  # a SolverSettings with stepping keys
-        linear=LinearSolverSettings(kind=scene.solver.linear_solver),
+        linear=LinearSolverSettings(
+            kind=scene.solver.linear_solver, forcing=scene.solver.forcing,
+            reuse_preconditioner=scene.solver.reuse_preconditioner,
+        ),
         observer=on_residual, predictor=scene.solver.predictor,
     )
     saved = restore(out / "checkpoint", problem, marker) if marker is not None else None

@@ -186,6 +186,8 @@ def test_scene_solver_options_give_the_same_answer(tmp_path):
         ("plain", 'predictor = "previous"'),
         ("extrapolated", 'predictor = "extrapolate"'),
         ("iterative", 'linear_solver = "iterative"'),
+        ("inexact", 'linear_solver = "iterative"\nforcing = "eisenstat-walker"\n'
+                    'reuse_preconditioner = "step"'),
     ):
         (tmp_path / f"{name}.toml").write_text(base.replace("[solver]", f"[solver]\n{extra}"))
         outcome = run_scene(
@@ -196,4 +198,6 @@ def test_scene_solver_options_give_the_same_answer(tmp_path):
         iterations[name] = outcome.path.iterations
     assert forces["extrapolated"] == pytest.approx(forces["plain"], rel=1e-8)
     assert forces["iterative"] == pytest.approx(forces["plain"], rel=1e-8)
+    assert forces["inexact"] == pytest.approx(forces["plain"], rel=1e-8)
+    assert iterations["inexact"] <= iterations["iterative"] + 1
     assert iterations["extrapolated"] <= iterations["plain"]

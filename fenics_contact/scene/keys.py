@@ -256,6 +256,15 @@ KEY_DOCS: dict[str, dict[str, KeyDoc]] = {
         "linear_solver": KeyDoc('"direct" | "iterative"', "MUMPS, or GMRES with a Schur field "
                                 "split and algebraic multigrid (large 3D).",
                                 field="SolverSpec.linear_solver"),
+        "forcing": KeyDoc('"fixed" | "eisenstat-walker"', "Krylov tolerance of each Newton "
+                          "step (linear_solver = \"iterative\"): rtol 1e-10 at every step, or "
+                          "inexact Newton (Eisenstat-Walker terms, loose far from the solution).",
+                          field="SolverSpec.forcing"),
+        "reuse_preconditioner": KeyDoc('"no" | "step" | "path"', "Keep the multigrid hierarchy "
+                                       "between Newton steps while the Krylov rate holds: "
+                                       "within a load step, or along the load path "
+                                       "(linear_solver = \"iterative\").",
+                                       field="SolverSpec.reuse_preconditioner"),
     },
     "output": {
         "fields": KeyDoc("array of strings", "Fields written to solution.xdmf, from "

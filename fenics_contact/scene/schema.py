@@ -44,7 +44,10 @@ Layout (units are the user's; be consistent)::
                  (extrapolate, and the first iteration's contact set from
                  the gaps' history),
                  linear_solver = "direct" (MUMPS) | "iterative" (GMRES,
-                 Schur field split, algebraic multigrid; for large 3D)
+                 Schur field split, algebraic multigrid; for large 3D),
+                 forcing = "fixed" | "eisenstat-walker" and
+                 reuse_preconditioner = "no" | "step" | "path" (iterative
+                 only: inexact Newton, multigrid kept between steps)
     [output]     fields = [...], pictures = true
 
 Deformable bodies in one mesh replace [material] and [contact] by::

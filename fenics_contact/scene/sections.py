@@ -188,6 +188,14 @@ def read_solver(reader: _Reader) -> SolverSpec:
         return reader.integer(key, default, minimum=minimum, maximum=maximum,
                               why=why_bounded(key))
 
+    linear_solver = reader.choice("linear_solver", ("direct", "iterative"), default="direct")
+    forcing = reader.choice("forcing", ("fixed", "eisenstat-walker"), default="fixed")
+    reuse = reader.choice("reuse_preconditioner", ("no", "step", "path"), default="no")
+    for key, value, default in (("forcing", forcing, "fixed"),
+                                ("reuse_preconditioner", reuse, "no")):
+        if value != default and linear_solver != "iterative":
+            raise reader.fail(key, "needs linear_solver = \"iterative\" "
+                              "(the direct solver solves exactly and has no preconditioner).")
     return SolverSpec(
         method=reader.choice("method", METHODS, default="gnrm"),
         steps=bounded("steps", 10, 1, MAX_STEPS),
@@ -197,7 +205,9 @@ def read_solver(reader: _Reader) -> SolverSpec:
         max_cutbacks=bounded("max_cutbacks", 4, 0, MAX_CUTBACKS),
         predictor=reader.choice("predictor", ("extrapolate", "previous", "active-set"),
                                 default="extrapolate"),
-        linear_solver=reader.choice("linear_solver", ("direct", "iterative"), default="direct"),
+        linear_solver=linear_solver,
+        forcing=forcing,
+        reuse_preconditioner=reuse,
     )
 
 

@@ -152,6 +152,8 @@ class SolverSpec(SolverSettings):
     max_cutbacks: int = 4
     predictor: str = "extrapolate"
     linear_solver: str = "direct"
+    forcing: str = "fixed"
+    reuse_preconditioner: str = "no"
 
 
 @dataclass(frozen=True)

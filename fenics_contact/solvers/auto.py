@@ -295,6 +295,7 @@ class AutoStrategy(NewtonStrategy):
         """Damped Newton: halve the step until the residual norm decreases enough."""
         a = self.tuning
         steps = 0
+        kernel.begin_solve()
         norm = kernel.assemble_residual()
         while True:
             status = monitor.check(norm, self.problem.active_signature(), iterations=steps)
@@ -302,7 +303,7 @@ class AutoStrategy(NewtonStrategy):
                 return status, steps
             start = kernel.x.copy()
             try:
-                if not kernel.newton_step():
+                if not kernel.newton_step(tolerance=monitor.tolerance()):
                     return monitor.fail(), steps
                 steps += 1
                 reference = max(monitor.residuals[-a.nonmonotone :])

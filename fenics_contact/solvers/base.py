@@ -75,14 +75,17 @@ def newton_loop(
     ``residual_norm`` assembles the residual the step needs and returns the
     norm used for the stopping test; ``after_step`` runs after each step
     (the simultaneous Uzawa update). Returns the status and the step count.
+    The monitor's tolerance bounds an inexact linear solve's forcing term
+    (:meth:`NewtonKernel.newton_step`).
     """
     steps = 0
+    kernel.begin_solve()
     while True:
         norm = residual_norm()
         status = monitor.check(norm, state(), iterations=steps)
         if status is not None:
             return status, steps
-        if not kernel.newton_step():
+        if not kernel.newton_step(tolerance=monitor.tolerance()):
             return monitor.fail(), steps
         steps += 1
         if after_step is not None:

@@ -22,7 +22,12 @@ from dolfinx.fem import petsc as fem_petsc
 from petsc4py import PETSc
 
 from fenics_contact.model.problem import VariationalSystem
-from fenics_contact.solvers.linear import LinearSolverSettings, configure_ksp
+from fenics_contact.solvers.linear import (
+    EisenstatWalker,
+    LinearSolverSettings,
+    PreconditionerLag,
+    configure_ksp,
+)
 from fenics_contact.solvers.timing import KernelTimings, stopwatch
 
 _prefix_counter = itertools.count()
@@ -78,6 +83,11 @@ class NewtonKernel:
         self._keep: tuple = ()
         self.linear_solves = 0
         self.residual_norm = np.inf
+        self.forcing: EisenstatWalker | None = None
+        self.lag: PreconditionerLag | None = None
+        self._built = False
+        #: Krylov tolerance of each linear solve (iterative solver).
+        self.krylov_rtols: list[float] = []
         #: Options this kernel put into PETSc's database; removed with the kernel
         #: (destroyed or collected), so none outlives its solver.
         self._options: list[str] = []
@@ -107,6 +117,32 @@ class NewtonKernel:
             name for name in PETSc.Options().getAll()
             if name.startswith(self._prefix) and name not in before
         )
+        self.forcing = (
+            EisenstatWalker(settings.eta_max, settings.rtol) if settings.inexact else None
+        )
+        self.lag = PreconditionerLag(settings.lag_factor) if settings.lagged else None
+
+    def begin_solve(self) -> None:
+        """A new nonlinear solve starts: the forcing term starts afresh.
+
+        So does the preconditioner, unless it is kept along the path.
+        """
+        if self.forcing is not None:
+            self.forcing.reset()
+        if self.lag is not None and self.linear.reuse_preconditioner == "step":
+            self.lag.reset()
+
+    def _reuse_preconditioner(self, flag: bool) -> None:
+        """Keep (or rebuild at the next set-up) the displacement block's multigrid."""
+        pc = self.ksp.getPC()
+        if pc.getType() == PETSc.PC.Type.FIELDSPLIT:
+            try:
+                sub = pc.getFieldSplitSubKSP()
+            except PETSc.Error:  # not set up yet: nothing to keep
+                return
+            sub[0].getPC().setReusePreconditioner(flag)
+        else:
+            pc.setReusePreconditioner(flag)
 
     # -- state transfer --------------------------------------------------------
     def _pull(self) -> None:
@@ -156,20 +192,51 @@ class NewtonKernel:
         comm = self.A.comm.tompi4py()
         return [float(np.sqrt(comm.allreduce(v))) for v in out]
 
-    def newton_step(self, damping: float = 1.0) -> bool:
+    def newton_step(self, damping: float = 1.0, tolerance: float = 0.0) -> bool:
         """Solve J dx = F at the current unknowns and set x <- x - damping dx.
 
         Requires a preceding :meth:`assemble_residual`. Returns False when the
         linear solve fails or produces non-finite values (unknowns untouched).
         Subclasses change what J and F are through :meth:`_assemble_A` and
-        :meth:`_assemble_b`.
+        :meth:`_assemble_b`. ``tolerance`` is the Newton tolerance of the
+        solve (residual norm), which bounds the Eisenstat-Walker forcing term
+        from below (an inexact solve need not go below it); 0 when unknown.
+        """
+        self._assemble_A()
+        iterative = self.linear.kind != "direct"
+        if self.forcing is not None:
+            self.ksp.setTolerances(rtol=self.forcing(self.residual_norm, tolerance))
+        if iterative:
+            self.krylov_rtols.append(self.ksp.getTolerances()[0])
+        if not self._linear_solve():
+            return False
+        if self.ksp.getConvergedReason() < 0 and self.lag is not None and not self._built:
+            # a kept hierarchy that no longer converges: rebuild it and solve again
+            self.lag.reset()
+            if not self._linear_solve():
+                return False
+        if self.ksp.getConvergedReason() < 0:
+            return False
+        if not np.all(np.isfinite(self.dx.getArray(readonly=True))):
+            return False
+        self.x.axpy(-damping, self.dx)
+        self._push()
+        return True
+
+    def _linear_solve(self) -> bool:
+        """Set up the solver (keeping the hierarchy if the lag allows) and solve into dx.
+
+        Returns False when PETSc stopped with an error; the caller reads the
+        converged reason otherwise.
         """
         t = self.timings
-        self._assemble_A()
+        self._built = build = self.lag is not None and self.lag.rebuild
         try:
             with stopwatch(t, "setup_s"):
                 if self._operator_each_step:
                     self.ksp.setOperators(self.A)
+                if self.lag is not None:
+                    self._reuse_preconditioner(not build)
                 self.ksp.setUp()
                 self.ksp.getPC().setUp()
             with stopwatch(t, "solve_s"):
@@ -178,16 +245,17 @@ class NewtonKernel:
             # A solve that stops with an error (e.g. a singular factorisation) leaves
             # b locked read-only: the next assembly into it would fail ("error code 73").
             self.b = self.b.duplicate()
+            if self.lag is not None:
+                self.lag.reset()
             return False
         self.linear_solves += 1
         t.linear_solves += 1
-        t.krylov_iterations += self.ksp.getIterationNumber() if self.linear.kind != "direct" else 0
-        if self.ksp.getConvergedReason() < 0:
-            return False
-        if not np.all(np.isfinite(self.dx.getArray(readonly=True))):
-            return False
-        self.x.axpy(-damping, self.dx)
-        self._push()
+        if self.linear.kind != "direct":
+            t.krylov_iterations += self.ksp.getIterationNumber()
+        if self.lag is not None:
+            rhs = self.b.norm()  # the Krylov start residual (zero initial guess)
+            reduction = self.ksp.getResidualNorm() / rhs if rhs > 0 else 0.0
+            self.lag.record(self.ksp.getIterationNumber(), reduction, build)
         return True
 
     def destroy(self) -> None:

@@ -40,6 +40,7 @@ class NestedUzawa(UzawaBase):
         steps = updates = 0
         fresh = True  # a Newton step was taken since the last update
         status: Status | None = None
+        self.kernel.begin_solve()
         while status is None:
             norm = self.residual_norm()
             status = monitor.check(norm, self.problem.active_signature(), iterations=steps)
@@ -48,7 +49,7 @@ class NestedUzawa(UzawaBase):
             dual_done = self.complementarity_norm <= monitor.tolerance()
             inner_tol = monitor.tolerance() if dual_done else self.tuning.inner_atol
             if self.primal_norm > inner_tol or not fresh:
-                if not self.kernel.newton_step():
+                if not self.kernel.newton_step(tolerance=inner_tol):
                     status = monitor.fail()
                 steps += 1
                 fresh = True
