@@ -1,7 +1,7 @@
 """Run every benchmark in sequence (one process per case) and gather the tables.
 
 ``python benchmarks/run_all.py [--quick]
-[--only hertz2d,cost,predict,compile,first,mortar,hertz3d,ladder,mpi,speedup]``.
+[--only hertz2d,cost,predict,compile,first,mortar,hertz3d,ladder,mpi,speedup,inexact]``.
 The ladder's large sizes take minutes each; ``--quick`` stops at 1e5 DOFs.
 Serial and 2-rank runs of a size are run one after the other, on a machine
 that others may be using: compare them side by side, not across days.
@@ -30,6 +30,12 @@ LADDER = [
 ]
 #: Serial and 2-rank runs of the same size back to back (the speed-up figures).
 SPEEDUP = [(1e5, 3), (1e6, 1)]
+#: Inexact Newton (issue 21, item 3): the iterative solver's variants interleaved
+#: (DOFs, ranks, rounds), then the inexact solver's single cases for memory per rank
+#: and the 1M-DOF point on 2 ranks beside the fixed-tolerance one.
+INEXACT = [(1e5, 1, 3), (1e5, 2, 3)]
+INEXACT_LADDER = [(1e5, "inexact", 1, 3), (1e5, "inexact", 2, 3), (1e6, "inexact", 2, 1),
+                  (1e6, "iterative", 2, 1)]
 
 
 def call(cmd: list[str]) -> None:
@@ -51,7 +57,7 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--only",
                         default="hertz2d,cost,predict,compile,first,mortar,hertz3d,ladder,mpi,"
-                                "speedup")
+                                "speedup,inexact")
     args = parser.parse_args()
     parts = set(args.only.split(","))
     limit = 1e5 if args.quick else 1e6
@@ -80,7 +86,14 @@ def main() -> None:
         if dofs <= limit:
             ladder_case(dofs, "iterative", 1, repeats)
             ladder_case(dofs, "iterative", 2, repeats)
-    if parts & {"ladder", "mpi", "speedup"}:
+    for dofs, ranks, rounds in INEXACT if "inexact" in parts else []:
+        cmd = [PYTHON, str(HERE / "performance" / "inexact_newton.py"), "--dofs", f"{dofs:g}",
+               "--rounds", str(rounds)]
+        call(([MPIEXEC, "-n", str(ranks)] if ranks > 1 else []) + cmd)
+    for dofs, solver, ranks, repeats in INEXACT_LADDER if "inexact" in parts else []:
+        if dofs <= limit:
+            ladder_case(dofs, solver, ranks, repeats)
+    if parts & {"ladder", "mpi", "speedup", "inexact"}:
         call([PYTHON, str(HERE / "performance" / "ladder3d.py"), "--table"])
 
 

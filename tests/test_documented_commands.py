@@ -54,6 +54,8 @@ COMMANDS: dict[str, str | tuple[str, str]] = {
     "--repeats 1":
         "{mpiexec} -n 2 {python} benchmarks/performance/ladder3d.py --dofs 1e3 --solver "
         "iterative --repeats 1 --out {out}",
+    "python benchmarks/performance/inexact_newton.py --dofs 1e5":
+        "{python} benchmarks/performance/inexact_newton.py --dofs 1e3 --rounds 1 --out {out}",
     "python benchmarks/performance/ladder3d.py --table":
         "{python} benchmarks/performance/ladder3d.py --table --out {out}",
     "python benchmarks/research/tradeoff.py --out results/tradeoff":

@@ -7,6 +7,7 @@ answer (to 1e-8); the forcing rule and the rebuild rule on their own.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -147,6 +148,10 @@ def test_settings_validation() -> None:
         LinearSolverSettings(kind="iterative", reuse_preconditioner=True)
     with pytest.raises(ValueError, match="eta_max"):
         LinearSolverSettings(kind="iterative", forcing="eisenstat-walker", eta_max=1.0)
+    assert LinearSolverSettings(kind="iterative").schur_factorisation == "full"
+    inexact = LinearSolverSettings(kind="iterative", forcing="eisenstat-walker")
+    assert inexact.schur_factorisation == "upper"
+    assert replace(inexact, schur_fact="full").schur_factorisation == "full"
     direct = LinearSolverSettings(forcing="eisenstat-walker", reuse_preconditioner="step")
     assert not direct.inexact and not direct.lagged  # MUMPS solves exactly, as before
 
