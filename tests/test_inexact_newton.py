@@ -120,6 +120,19 @@ def test_forcing_terms_choice_two_with_safeguards() -> None:
     ew.reset()
     ew(1.0)
     assert ew(1e-9) == 1e-10
+    # the first term of a solve: a tenth of the first reduction of the last solve
+    # (0.1 -> 0.01), at most eta_max
+    ew = EisenstatWalker(eta_max=0.1, eta_min=1e-10)
+    ew(1.0)
+    ew(0.1)
+    ew.reset()
+    assert ew(2.0) == pytest.approx(0.01)
+    ew(2e-6)  # a first step that reduced by 1e-6: the next solve starts at 1e-7
+    ew.reset()
+    assert ew(1.0) == pytest.approx(1e-7)
+    ew(3.0)  # a first step that did not reduce: back to eta_max
+    ew.reset()
+    assert ew(1.0) == 0.1
     # after a loose term the safeguard holds the next one up: 0.9 * 0.9^2 > 0.9 * 0.5^2
     big = EisenstatWalker(eta_max=0.9)
     assert big(1.0) == 0.9
@@ -157,6 +170,34 @@ def test_settings_validation() -> None:
 
 
 SCENES = Path(__file__).parent.parent / "scenes"
+
+
+def test_a_nearly_linear_problem_learns_a_tight_first_step(tmp_path) -> None:
+    """2D sliding with friction, where exact Newton takes 2 steps per load step: an
+    inexact first step (eta_max) costs a third; from the first solve's reduction
+    the next ones start tight enough (39 fixed, 48 with eta_max at every first
+    step, 42 learnt)."""
+    from fenics_contact.runner import run_scene
+
+    base = (SCENES / "block_slide_friction.toml").read_text()
+    results = {}
+    for name, extra in (("fixed", 'linear_solver = "iterative"'),
+                        ("inexact", 'linear_solver = "iterative"\n'
+                                    'forcing = "eisenstat-walker"\n'
+                                    'reuse_preconditioner = "step"')):
+        (tmp_path / f"{name}.toml").write_text(base.replace("[solver]", f"[solver]\n{extra}"))
+        outcome = run_scene(load_scene(tmp_path / f"{name}.toml"), tmp_path / name,
+                            pictures=False)
+        assert outcome.path.converged
+        results[name] = outcome.path
+    fixed, inexact = results["fixed"], results["inexact"]
+    assert inexact.iterations <= fixed.iterations + 3
+    fixed_steps = [s.iterations for s in fixed.steps]
+    steps = [s.iterations for s in inexact.steps]
+    assert fixed_steps[:8] == [2] * 8
+    assert steps[:2] == [3, 3] and steps[2:8] == [2] * 6  # learnt after the first solves
+    assert inexact.steps[-1].contact_force == pytest.approx(fixed.steps[-1].contact_force,
+                                                            rel=1e-8)
 
 
 @pytest.mark.parametrize("key", ['forcing = "eisenstat-walker"', 'reuse_preconditioner = "step"'])

@@ -147,14 +147,20 @@ class EisenstatWalker:
         eta_k = gamma (||F_k|| / ||F_(k-1)||)^alpha,  gamma = 0.9, alpha = 2,
 
     safeguarded against a sudden drop (eta_k >= gamma eta_(k-1)^alpha when
-    that exceeds 0.1), capped by ``eta_max`` and, at the first step of a
-    solve, equal to it. Near convergence the term is not tighter than half
-    the Newton tolerance over the residual (no oversolving: the linear
-    residual of the last step is then below half the tolerance, so the next
-    Newton residual reaches it), and never tighter than ``eta_min``.
+    that exceeds 0.1) and capped by ``eta_max``. The first step of a solve
+    has no ratio to go by: it uses a tenth of the reduction the first step
+    of the previous solve achieved, ``||F_1|| / ||F_0||`` (``eta_max`` at
+    most, and at the first solve). A nearly linear problem, whose first
+    Newton step alone reduces the residual by orders of magnitude, so
+    starts tight instead of wasting that step on an inexact solve (which
+    costs an extra Newton step per load step). Near convergence the term is
+    not tighter than half the Newton tolerance over the residual (no
+    oversolving: the linear residual of the last step is then below half
+    the tolerance, so the next Newton residual reaches it), and never
+    tighter than ``eta_min``.
 
     Args:
-        eta_max: largest forcing term (and the first one).
+        eta_max: largest forcing term.
         eta_min: smallest forcing term (the fixed Krylov tolerance).
     """
 
@@ -162,21 +168,33 @@ class EisenstatWalker:
     alpha = 2.0
     #: Level above which the previous term bounds the next (the choice 2 safeguard).
     safeguard = 0.1
+    #: The first term of a solve over the first reduction of the previous solve.
+    first_margin = 0.1
 
     def __init__(self, eta_max: float = 0.01, eta_min: float = 1e-10) -> None:
         self.eta_max = eta_max
         self.eta_min = eta_min
+        self._first_ratio = np.inf
         self.reset()
 
     def reset(self) -> None:
-        """Forget the history: the next term is ``eta_max`` (a new nonlinear solve)."""
+        """A new nonlinear solve: the next term is the first of a solve."""
+        self._steps = 0
         self._norm = np.inf
         self._eta = self.eta_max
 
+    def first(self) -> float:
+        """The first term of a solve (before any tolerance bound)."""
+        eta = self.first_margin * self._first_ratio
+        return float(max(min(eta, self.eta_max), self.eta_min))
+
     def __call__(self, norm: float, tolerance: float = 0.0) -> float:
         """The forcing term of a step at residual ``norm`` (Newton tolerance ``tolerance``)."""
+        self._steps += 1
+        if self._steps == 2 and np.isfinite(self._norm) and self._norm > 0.0:
+            self._first_ratio = norm / self._norm
         if not np.isfinite(self._norm) or self._norm <= 0.0:
-            eta = self.eta_max
+            eta = self.first()
         else:
             eta = self.gamma * (norm / self._norm) ** self.alpha
             bound = self.gamma * self._eta**self.alpha
