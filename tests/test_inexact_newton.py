@@ -14,6 +14,10 @@ import numpy as np
 import pytest
 
 import fenics_contact  # noqa: F401  (before dolfinx)
+
+# isort: split
+from mpi4py import MPI
+
 from benchmarks import cases
 from fenics_contact.scene.schema import load_scene
 from fenics_contact.scene.spec import SceneError
@@ -31,8 +35,10 @@ NEWTON = SolverSettings(atol=1e-12, rtol=1e-10, max_iterations=30)
 INEXACT = {"forcing": "eisenstat-walker"}
 
 
-def solve(method: str = "gnrm", n: int = 10, **linear) -> tuple:
-    problem = cases.build(cases.block_indentation(n, depth=0.03, candidate_width=0.5), 1.0)
+def solve(method: str = "gnrm", n: int = 10, comm: MPI.Comm = MPI.COMM_WORLD, **linear) -> tuple:
+    problem = cases.build(
+        cases.block_indentation(n, depth=0.03, candidate_width=0.5), 1.0, comm=comm
+    )
     strategy = make_strategy(method, problem, NEWTON)
     strategy.kernel.set_linear_solver(LinearSolverSettings(kind="iterative", **linear))
     path = solve_load_path(Extrapolated(strategy), 2, max_cutbacks=0)
@@ -78,6 +84,21 @@ def test_kept_hierarchy_same_answer_and_built_once_per_step_or_path(fixed, reuse
     same_answer(problem_r, problem_f)
     assert kernel_r.lag.builds == builds
     assert kernel_r.linear_solves == path_r.iterations  # no solve repeated
+
+
+@pytest.mark.mpi
+def test_parallel_inexact_run_matches_serial() -> None:
+    """On 2 ranks under `make test`: the serial Newton counts and answer (to 1e-8)."""
+    results = {}
+    for name, comm in (("world", MPI.COMM_WORLD), ("self", MPI.COMM_SELF)):
+        problem, path, kernel = solve(comm=comm, **INEXACT, reuse_preconditioner="step")
+        results[name] = ([s.iterations for s in path.steps], path.steps[-1].contact_force,
+                         problem.u.x.petsc_vec.norm(), kernel.lag.builds)
+    world, serial = results["world"], results["self"]
+    assert world[0] == serial[0]
+    assert world[1] == pytest.approx(serial[1], rel=1e-8)
+    assert world[2] == pytest.approx(serial[2], rel=1e-8)
+    assert world[3] == serial[3] == 2
 
 
 def test_kept_hierarchy_on_a_single_block_system() -> None:
