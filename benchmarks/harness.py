@@ -10,6 +10,7 @@ built and is reported apart as ``build_s``.
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import platform
@@ -70,6 +71,24 @@ def write(name: str, data: dict, table: str, out: Path = OUT) -> None:
     out.mkdir(parents=True, exist_ok=True)
     (out / f"{name}.json").write_text(json.dumps(data, indent=2, default=float) + "\n")
     (out / f"{name}.md").write_text(table.rstrip() + "\n")
+
+
+def figure_parser(doc: str, sizes: Sequence[float] | None = None) -> argparse.ArgumentParser:
+    """The command line of a validation script: --out, --figure and, given sizes, --sizes."""
+    parser = argparse.ArgumentParser(description=doc.splitlines()[0])
+    parser.add_argument("--out", type=Path, default=Path("results/bench"))
+    parser.add_argument("--figure", type=Path, default=None)
+    if sizes is not None:
+        parser.add_argument("--sizes", default=",".join(map(str, sizes)),
+                            type=lambda v: [float(x) for x in v.split(",")])
+    return parser
+
+
+def save_figure(fig, path: Path) -> None:
+    """Write a matplotlib figure (the folder made when missing) and say so."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
+    print(f"Wrote {path}")
 
 
 def report(name: str, runs: Sequence[dict], header: Sequence[str], columns: Sequence[str],

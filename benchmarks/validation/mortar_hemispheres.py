@@ -17,7 +17,6 @@ Run: ``python benchmarks/validation/mortar_hemispheres.py [--out results/bench]
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import sys
 import time
@@ -30,7 +29,7 @@ import numpy as np
 from mpi4py import MPI
 
 import fenics_contact  # noqa: F401  (the DOLFINx wheel first)
-from benchmarks.harness import report
+from benchmarks.harness import figure_parser, report, save_figure
 from fenics_contact import build_problem, load_scene, make_strategy, solve_load_path
 from fenics_contact.references.hertz import fit_contact_profile
 from fenics_contact.references.hertz3d import hertz_point_contact
@@ -104,18 +103,13 @@ def picture(runs: list[dict], h: float, path: Path) -> None:
     np.atleast_1d(axes)[0].set_ylabel("p / p0 (Hertz)")
     fig.suptitle("Two hemispheres on non-matching tetrahedra", fontsize=10)
     fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path)
 
 
 def main() -> None:
     """Command line."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=Path("results/bench"))
-    parser.add_argument("--figure", type=Path, default=None)
-    parser.add_argument("--sizes", default=",".join(map(str, SIZES)))
-    args = parser.parse_args()
-    sizes = [float(v) for v in args.sizes.split(",")]
+    args = figure_parser(__doc__, SIZES).parse_args()
+    sizes = args.sizes
     runs = [solve(h, d) for h in sizes for d in DISCRETISATIONS]
     if MPI.COMM_WORLD.rank != 0:
         return
@@ -130,7 +124,6 @@ def main() -> None:
     print(table)
     if args.figure is not None:
         picture(runs, min(sizes), args.figure)
-        print(f"Wrote {args.figure}")
 
 
 if __name__ == "__main__":

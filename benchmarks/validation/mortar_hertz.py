@@ -16,7 +16,6 @@ Run: ``python benchmarks/validation/mortar_hertz.py [--out results/bench]
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import sys
 from pathlib import Path
@@ -29,7 +28,7 @@ from mpi4py import MPI
 
 import fenics_contact  # noqa: F401  (the DOLFINx wheel first)
 from benchmarks.cases import two_cylinders
-from benchmarks.harness import report
+from benchmarks.harness import figure_parser, report, save_figure
 from fenics_contact import build_problem, make_strategy, solve_load_path
 from fenics_contact.references.hertz import hertz_line_contact
 from fenics_contact.solvers.diagnostics import SolverSettings
@@ -92,18 +91,13 @@ def picture(runs: list[dict], h: float, path: Path) -> None:
     ax.set_title(f"Two cylinders on non-matching meshes, h = {h:g} R")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path)
 
 
 def main() -> None:
     """Command line."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=Path("results/bench"))
-    parser.add_argument("--figure", type=Path, default=None)
-    parser.add_argument("--sizes", default=",".join(map(str, SIZES)))
-    args = parser.parse_args()
-    sizes = [float(v) for v in args.sizes.split(",")]
+    args = figure_parser(__doc__, SIZES).parse_args()
+    sizes = args.sizes
     runs = [solve(h, d) for h in sizes for d in DISCRETISATIONS]
     if MPI.COMM_WORLD.rank != 0:
         return
@@ -114,7 +108,6 @@ def main() -> None:
     print(table)
     if args.figure is not None:
         picture(runs, 0.01 if 0.01 in sizes else sizes[0], args.figure)
-        print(f"Wrote {args.figure}")
 
 
 if __name__ == "__main__":

@@ -16,7 +16,6 @@ Run: ``python benchmarks/validation/mortar_patch.py [--out results/bench]
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import sys
 from pathlib import Path
@@ -26,7 +25,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 import numpy as np
 
 import fenics_contact  # noqa: F401  (the DOLFINx wheel first)
-from benchmarks.harness import report
+from benchmarks.harness import figure_parser, report, save_figure
 from fenics_contact import build_problem, load_scene, make_strategy, solve_load_path
 from fenics_contact.solvers.diagnostics import SolverSettings
 
@@ -75,16 +74,12 @@ def picture(runs: list[dict], path: Path) -> None:
         ax.legend(fontsize=8)
     axes[0].set_ylabel("nodal pressure / exact")
     fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path)
 
 
 def main() -> None:
     """Command line."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=Path("results/bench"))
-    parser.add_argument("--figure", type=Path, default=None)
-    args = parser.parse_args()
+    args = figure_parser(__doc__).parse_args()
     runs = [solve(dim, d) for dim in SCENES for d in DISCRETISATIONS]
     table = report("mortar_patch", runs, ["", "pair", "status", "Newton",
                                           "pressure spread / exact", "force error"],
@@ -93,7 +88,6 @@ def main() -> None:
     print(table)
     if args.figure is not None:
         picture(runs, args.figure)
-        print(f"Wrote {args.figure}")
 
 
 if __name__ == "__main__":
