@@ -393,15 +393,22 @@ def stack_automatic(steps: int = 2) -> Scene:
     return _scene("stack_3_blocks_automatic", data)
 
 
-def junction_blocks(slide: float = 0.0, steps: int = 2) -> Scene:
+def junction_blocks(slide: float = 0.0, steps: int = 2, held: bool = False) -> Scene:
     """A block pressed onto two blocks side by side (a node touching both), pairs automatic.
 
     ``slide`` > 0: the top block is pressed by 0.008 up to load factor 0.3,
     then slides right by ``slide``: past 0.5 it leaves the left block (that
     contact opens) while its contact with the right one closes over more nodes.
+    ``held``: the left block's outer wall holds it vertically too (u = 0
+    there, not only u_x). Without it, once the top block has left, nothing
+    holds the left block down against the frictionless joint, which pushes
+    it up (docs/contacts.md): the static problem has no solution.
     """
     data = _shipped("junction_blocks")
     data["solver"]["steps"] = steps
+    if held:
+        wall = next(d for d in data["dirichlet"] if d["tag"] == "left_wall")
+        wall["value"] = [0.0, 0.0]
     if slide:
         top = data["dirichlet"][2]
         top.pop("value")

@@ -85,13 +85,17 @@ def many_contacts_grid() -> list[StabilityCase]:
 
     A body touching two others (the middle block of a stack; a block on two
     blocks side by side, one node on both), a contact opening while another
-    closes (that block sliding off the left block onto the right one), and
+    closes (that block sliding off the left block onto the right one; once
+    off, the left block is held down by nothing, so a variant holds its
+    outer wall vertically), and
     self-contact (the tube crushed until its inner wall closes).
     """
     return [
         StabilityCase("stack-automatic", "many-contacts", stack_automatic()),
         StabilityCase("junction", "many-contacts", junction_blocks()),
         StabilityCase("junction-slide-off", "many-contacts", junction_blocks(0.6, 10)),
+        StabilityCase("junction-slide-off-held", "many-contacts",
+                      junction_blocks(0.6, 10, held=True)),
         StabilityCase("junction-r1e8", "many-contacts", junction_blocks(), 1e8),
         StabilityCase("tube-self-contact", "many-contacts", tube_crush()),
     ]
