@@ -45,6 +45,12 @@ def test_junction_auto_reaches_the_gnrm_answer():
     for name, force in forces(ref).items():
         assert forces(record)[name] == pytest.approx(force, rel=1e-8), name
     assert record.u_rms == pytest.approx(ref.u_rms, rel=1e-8)
+    # r = 1e8 E/h: GNRM diverges there; auto reaches the r = 1 answer (10 Newton iterations)
+    huge = run_case(CASES["junction-r1e8"], "auto", comm=MPI.COMM_SELF)
+    assert huge.status == "converged", huge.message
+    assert sum(s.iterations for s in huge.steps) <= 15
+    for name, force in forces(ref).items():
+        assert forces(huge)[name] == pytest.approx(force, rel=1e-8), name
 
 
 def test_slide_off_converges_once_the_left_block_is_held():
