@@ -178,8 +178,10 @@ def test_mortar_cattaneo_mindlin_coarse_non_matching(tmp_path):
 
     Measured: Q/(mu P) = 0.23, 0.45, 0.67, 0.87; stick half-width errors
     -2.1, -3.8, -2.3, -9.0 % of c (node spacing at the edge 3.4 ... 8.3 %);
-    traction L2 errors 46, 23, 9.5, 5.0 %. The shipped mesh (h = 0.003,
-    12 steps; benchmarks/validation/cattaneo_mortar.py) is within 4.4 % in c.
+    traction L2 errors (the nodal force per tributary length of the multiplier field)
+    22, 11, 5.6, 3.3 % (the multipliers themselves: 46, 23, 9.5, 5.0 %). The
+    shipped mesh (h = 0.003, 12 steps; benchmarks/validation/cattaneo_mortar.py)
+    is within 4.4 % in c.
     """
     from benchmarks.validation.cattaneo import solve_cattaneo_mindlin
     from benchmarks.validation.cattaneo_mortar import mortar_scene
@@ -191,4 +193,5 @@ def test_mortar_cattaneo_mindlin_coarse_non_matching(tmp_path):
     for zone in run.zones:
         assert zone.stick_nodes > 0 and zone.slip_nodes > 0
         assert abs(zone.c_error) < 0.1, zone
-    assert run.zones[-1].traction_error < 0.06
+    assert run.zones[-1].traction_error < 0.04
+    assert run.zones[-2].traction_error < 0.07

@@ -6,6 +6,8 @@ import numpy as np
 import pytest
 from test_mortar import LOAD_TAG, SUPPORT_TAG, _mesh, _problem, _solve
 
+from mpi4py import MPI
+
 from benchmarks import cases
 from fenics_contact.references.hertz import half_width, peak_pressure, pressure_profile
 
@@ -38,16 +40,23 @@ def cylinders() -> dict:
 def test_mortar_two_cylinders_hertz(cylinders: dict) -> None:
     """Nodal pressure against Hertz at h = 0.01 (a/h ~ 8); node-to-segment for comparison.
 
-    Measured: mortar peak +0.73 %, L2 over |x| < 1.5 a 9.7 % (the two nodes at each edge of
-    the contact zone), L2 over |x| < a - 2 h 1.6 %; node-to-segment +2.7 %, 5.6 %, 4.0 %.
+    The nodal pressure of a 2D mortar pair is the multiplier field's nodal force per
+    tributary length. Measured: mortar peak +0.14 %, L2 over |x| < 1.5 a 3.8 % (the node
+    at each edge of the contact zone), L2 over |x| < a - 2 h 0.62 %; node-to-segment
+    +2.7 %, 5.6 %, 4.0 %. The multipliers themselves: +0.73 %, 9.7 %, 1.6 %.
     """
     mortar = cylinders[1.0]
     nts = _cylinders("node-to-segment", 1.0)
     print({k: (mortar[k], nts[k]) for k in ("peak", "l2", "l2_inner")})
     assert mortar["state"].max_penetration < 1e-10
-    assert abs(mortar["peak"]) < 0.01 < abs(nts["peak"])
-    assert mortar["l2_inner"] < 0.02 < nts["l2_inner"]
-    assert mortar["l2"] < 0.10  # the aim (2 %) is missed at the edges of the zone
+    assert abs(mortar["peak"]) < 0.005 and abs(nts["peak"]) > 0.01
+    assert mortar["l2_inner"] < 0.01 and nts["l2_inner"] > 0.02
+    assert mortar["l2"] < 0.05 < nts["l2"]  # the aim (2 %) is missed at the edges of the zone
+    # the active set is the multipliers': the node past the last active one carries a
+    # share of its neighbour's force but is open
+    state = mortar["state"]
+    assert state.active_count == MPI.COMM_WORLD.allreduce(int(np.sum(state.multiplier < 0)))
+    assert np.sum(mortar["p"] > 0) > state.active_count
 
 
 def test_mortar_two_cylinders_quadratic_and_r_independent(cylinders: dict) -> None:

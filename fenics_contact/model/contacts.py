@@ -185,6 +185,15 @@ class Contact:
         pressure[pressure > -1e-12 * peak] = 0.0
         return pressure
 
+    def reported(self, values: np.ndarray) -> np.ndarray:
+        """Owned nodal values as written and measured (pressure, traction, Coulomb limit).
+
+        The nodal values themselves here; a discretisation whose multiplier
+        is not a nodal force per area (the 2D mortar pair) reports that
+        instead. ``values`` has one row per owned node (and any columns).
+        """
+        return values
+
     def contact_state(self) -> ContactState:
         """Nodal gaps, pressures, the active set and global summaries (fresh search).
 
@@ -199,8 +208,10 @@ class Contact:
         lam = self.lam.x.array[: gap.size].copy()
         force_form = (self._multiplier_force_form if self.multiplier_is_pressure
                       else self._force_form)
+        pressure = self.nodal_pressure(lam)
         state = ContactState.gathered(
-            self.comm, gap, self.nodal_pressure(lam), lam, fem.assemble_scalar(force_form)
+            self.comm, gap, self.reported(pressure), lam, fem.assemble_scalar(force_form),
+            active=pressure < 0.0,
         )
         depth = self.penetration()
         if depth is not None:

@@ -268,7 +268,7 @@ class CoulombFriction:
         """
         traction_forms = (self._multiplier_forms[1] if self._reports_multipliers
                           else self._global_forms[0])
-        return (self._nodal_components(traction_forms),
+        return (self.contact.reported(self._nodal_components(traction_forms)),
                 self._nodal_components(self._global_forms[1]))
 
     def tangential_force_vector(self) -> np.ndarray:
@@ -288,10 +288,10 @@ class CoulombFriction:
         multipliers = self._reports_multipliers
         return FrictionalContactState(**{
             **normal,
-            "tangential_traction": self._nodal_components(
-                self._multiplier_forms[0] if multipliers else self._tau_forms),
+            "tangential_traction": self.contact.reported(self._nodal_components(
+                self._multiplier_forms[0] if multipliers else self._tau_forms)),
             "slip": self._nodal_components(self._slip_forms),
-            "coulomb_limit": self._pressure_and_radius()[1],
+            "coulomb_limit": self.contact.reported(self._pressure_and_radius()[1]),
             "node_state": states,
             "tangential_force": float(np.linalg.norm(self.tangential_force_vector())),
             "tangential_magnitude": comm.allreduce(fem.assemble_scalar(

@@ -36,7 +36,7 @@ from dolfinx import default_scalar_type, fem, la
 
 from mpi4py import MPI
 
-from fenics_contact.model.contact import ContactSettings, ContactSurface
+from fenics_contact.model.contact import ContactSettings, ContactSurface, assemble_local
 from fenics_contact.model.contacts import Contact
 from fenics_contact.model.friction import FrictionSettings
 from fenics_contact.model.mortar_friction import mortar_slip
@@ -335,6 +335,39 @@ class MortarContact(Contact):
         #: that the compiled forms do not depend on the mesh).
         self.open_gap = fem.Constant(solid.domain, default_scalar_type(self.surface.h))
         return self.mortar.nodal_gap(X, X + solid.u, self.open_gap)
+
+    def reported(self, values: np.ndarray) -> np.ndarray:
+        """2D: the nodal force per tributary length of the multiplier field (stress).
+
+        With the standard basis the multiplier field is lam_h = sum_j lam_j N_j
+        and striker node k receives the force int N_k lam_h dA: its nodal
+        pressure is that force over int N_k dA, the lumped L2 projection of
+        lam_h (what node-to-segment's multiplier and the 3D dual basis are at
+        the nodes). The multipliers themselves swing at the edge of a
+        contact zone (the last active node overshoots while its neighbour,
+        whose weighted gap averages over a support reaching past the edge,
+        opens). The active set stays the multipliers'. 3D: the dual basis
+        already gives the nodal force per area; the values are returned.
+        """
+        if self.gdim == 3:
+            return values
+        columns = values.reshape(values.shape[0], -1)
+        out = np.column_stack([self._nodal_force_per_length(c) for c in columns.T])
+        return out.reshape(values.shape)
+
+    def _nodal_force_per_length(self, values: np.ndarray) -> np.ndarray:
+        """The nodal means int N_k v_h dA / int N_k dA at the owned striker nodes (v_h: P1)."""
+        if getattr(self, "_report_form", None) is None:
+            self._report_field = fem.Function(self.Q)
+            exact = self.surface.ds_nodal.reconstruct(metadata={"quadrature_degree": 2})
+            self._report_form = fem.form(
+                self._report_field * ufl.TestFunction(self.Q) * exact,
+                entity_maps=self.surface.entity_maps)
+        field = self._report_field
+        field.x.array[:] = 0.0
+        field.x.array[: values.size] = values
+        field.x.scatter_forward()
+        return assemble_local(self._report_form) / self.surface.lumped_area
 
     def slip_increment(self, u_prev: fem.Function) -> tuple[ufl.core.expr.Expr, ufl.core.expr.Expr]:
         """(T_j, s~_j) of the Coulomb terms.

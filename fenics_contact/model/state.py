@@ -85,6 +85,7 @@ class ContactState:
         pressure: np.ndarray,
         multiplier: np.ndarray,
         local_force: float,
+        active: np.ndarray | None = None,
     ) -> ContactState:
         """The state from this rank's nodal values, with the summaries reduced over ``comm``.
 
@@ -94,8 +95,10 @@ class ContactState:
             pressure: owned nodal pressure (<= 0, stress); active where < 0.
             multiplier: owned nodal multipliers.
             local_force: this rank's share of the contact force (force).
+            active: owned active nodes (default: where ``pressure`` < 0).
         """
-        active = pressure < 0.0
+        if active is None:
+            active = pressure < 0.0
         return cls(
             gap=gap,
             pressure=pressure,
