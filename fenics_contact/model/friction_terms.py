@@ -251,7 +251,7 @@ class CoulombFriction:
                 self.surface.nodal(self._rho_form))
 
     def node_states(self) -> np.ndarray:
-        """Per owned node: 0 open (p_n = 0), 1 stick (|y| < rho, :func:`~.friction.sticks`), 2 slip."""
+        """Per owned node: 0 open (p_n = 0), 1 stick (:func:`~.friction.sticks`), 2 slip."""
         y = self._nodal_components(self._y_forms)
         pressure, rho = self._pressure_and_radius()
         stick = sticks(y, rho, float(self.eps.value))
