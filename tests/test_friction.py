@@ -264,6 +264,37 @@ def test_zero_slip_node_gives_finite_residual_and_jacobian():
     assert np.all(np.isfinite(problem.lam_t.x.array))
 
 
+def test_a_node_on_the_coulomb_circle_slips():
+    """|y| = rho to round-off (a node that slipped, at zero slip increment) takes the slip branch.
+
+    The projection's derivative is 0 there (2D, slip) and 1 well inside the disc
+    (stick); :func:`sticks` (the stick/slip output) follows the same rule.
+    """
+    import ufl
+    from dolfinx import fem, mesh
+
+    from fenics_contact.model.friction import coulomb_projection, sticks
+
+    rho, eps = 0.8, 2e-10
+    domain = mesh.create_unit_square(MPI.COMM_SELF, 1, 1)
+    Y = fem.Constant(domain, np.array([0.0]))
+    R = fem.Constant(domain, rho)
+    y = ufl.variable(ufl.as_vector([Y[0]]))
+    tau = coulomb_projection(y, R, fem.Constant(domain, eps))
+    expr = fem.Expression(ufl.as_vector([tau[0], ufl.diff(tau, y)[0, 0]]),
+                          np.array([[0.25, 0.25]]))
+    for value, stick in ((rho * (1 - 2e-16), False), (rho, False), (rho * (1 + 2e-16), False),
+                         (-rho, False), (0.5 * rho, True), (rho - 3 * eps, True)):
+        Y.value[:] = value
+        t, dt = expr.eval(domain, np.array([0], np.int32)).reshape(-1)
+        assert sticks(np.array([[value]]), np.array([rho]), eps)[0] == stick, value
+        if stick:
+            assert (t, dt) == (value, 1.0)
+        else:
+            assert t == pytest.approx(np.sign(value) * rho, rel=1e-15) and abs(dt) < 1e-15
+    assert not sticks(np.zeros((1, 1)), np.zeros(1), eps)  # open: rho = 0
+
+
 def test_scene_rejects_a_bad_friction_coefficient(tmp_path):
     text = SCENE.read_text()
     bad = tmp_path / "bad.toml"

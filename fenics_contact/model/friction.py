@@ -134,10 +134,23 @@ def coulomb_projection(
     """Projection of the tangential vector y onto the disc |tau| <= rho (rho >= 0).
 
     The norm is guarded, |y| ~ sqrt(y . y + eps^2), so that y = 0 gives no NaN
-    in either branch or in their derivatives.
+    in either branch or in their derivatives. A node sticks when the guarded
+    norm is below rho by more than eps (:func:`sticks`).
     """
     norm = ufl.sqrt(ufl.dot(y, y) + eps**2)
-    return ufl.conditional(ufl.lt(norm, rho), 1.0, rho / norm) * y
+    return ufl.conditional(ufl.lt(norm + eps, rho), 1.0, rho / norm) * y
+
+
+def sticks(y: np.ndarray, rho: np.ndarray, eps: float) -> np.ndarray:
+    """Whether nodes with trial tractions y (n, d-1) and radii rho (n,) stick.
+
+    The rule of :func:`coulomb_projection`: sqrt(|y|^2 + eps^2) + eps < rho.
+    The margin eps settles the tie |y| = rho, where every node that slipped
+    in the last step starts the next one (its slip increment is 0 there, so
+    y = lam_t and |lam_t| = rho up to round-off): the node slips, whatever
+    the round-off (which depends on the number of processes).
+    """
+    return np.sqrt(np.sum(y**2, axis=1) + eps**2) + eps < rho
 
 
 def surface_extent(submesh: mesh.Mesh) -> float:

@@ -26,6 +26,7 @@ from fenics_contact.model.friction import (
     FrictionalContactState,
     FrictionSettings,
     coulomb_projection,
+    sticks,
     surface_extent,
     symmetry_planes,
 )
@@ -250,14 +251,13 @@ class CoulombFriction:
                 self.surface.nodal(self._rho_form))
 
     def node_states(self) -> np.ndarray:
-        """Per owned node: 0 open (p_n = 0), 1 stick (|y| < rho), 2 slip."""
+        """Per owned node: 0 open (p_n = 0), 1 stick (:func:`~.friction.sticks`), 2 slip."""
         y = self._nodal_components(self._y_forms)
         pressure, rho = self._pressure_and_radius()
-        eps = float(self.eps.value)
-        norm = np.sqrt(np.sum(y**2, axis=1) + eps**2)
+        stick = sticks(y, rho, float(self.eps.value))
         state = np.full(rho.size, OPEN, dtype=np.int8)
         active = pressure < 0.0
-        state[active] = np.where(norm[active] < rho[active], STICK, SLIP)
+        state[active] = np.where(stick[active], STICK, SLIP)
         return state
 
     def tangential_fields(self) -> tuple[np.ndarray, np.ndarray]:

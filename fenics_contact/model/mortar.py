@@ -351,7 +351,9 @@ class MortarContact(Contact):
         """
         if self.gdim == 3:
             return values
-        columns = values.reshape(values.shape[0], -1)
+        # explicit width: a rank without striker nodes has 0 rows and must still take
+        # part in every (collective) column
+        columns = values.reshape(values.shape[0], int(np.prod(values.shape[1:])))
         out = np.column_stack([self._nodal_force_per_length(c) for c in columns.T])
         return out.reshape(values.shape)
 
