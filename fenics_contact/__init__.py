@@ -34,6 +34,7 @@ try:  # the wheel build of DOLFINx must be imported before dolfinx/petsc4py
 except ImportError:  # DOLFINx installed otherwise (official images)
     pass
 
+from fenics_contact import form_compiler
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import material
 from fenics_contact.model.obstacles import RigidBall, RigidPlane
@@ -49,6 +50,8 @@ from fenics_contact.solvers import STRATEGIES, make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings, Status
 from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.stepping import RunRecord, StepRecord, solve_load_path
+
+form_compiler.install()  # FFCx's value numbering in linear time (see form_compiler)
 
 __version__ = "0.1.0"
 

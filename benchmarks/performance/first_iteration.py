@@ -8,8 +8,12 @@ every form is compiled (FFCx and the C compiler); ``warm``: the same cache
 again (median of ``--repeats``). Writes ``OUT/first_iteration.json`` and
 ``.md``.
 
+``--scan-too`` adds, per scene, a cold run with FFCx's own node lookup in
+its value numbering (:mod:`fenics_contact.form_compiler` replaces it by a
+dictionary): the first start before and after, measured side by side.
+
 Run: ``python benchmarks/performance/first_iteration.py [--repeats 2]
-[--scenes two_hemispheres_3d,block_on_block_3d] [--out results/bench]``.
+[--scenes two_hemispheres_3d,block_on_block_3d] [--scan-too] [--out results/bench]``.
 """
 
 from __future__ import annotations
@@ -33,6 +37,8 @@ CHILD = """
 import json, sys, time, tempfile
 start = time.perf_counter()
 import fenics_contact
+if {scan!r}:
+    fenics_contact.form_compiler.uninstall()
 from fenics_contact.runner import run_scene
 from fenics_contact.scene.schema import load_scene
 imported = time.perf_counter() - start
@@ -56,10 +62,16 @@ print(json.dumps({{"import_s": imported, "first_iteration_s": time.perf_counter(
 """
 
 
-def once(scene: Path, cache: str) -> dict:
-    """One run in a fresh process with ``XDG_CACHE_HOME=cache``."""
+def once(scene: Path, cache: str, scan: bool = False) -> dict:
+    """One run in a fresh process with ``XDG_CACHE_HOME=cache``.
+
+    ``scan``: with FFCx's own node lookup in its value numbering (a scan of
+    the whole graph per lookup) instead of the dictionary the package
+    installs (:mod:`fenics_contact.form_compiler`).
+    """
     env = dict(os.environ, XDG_CACHE_HOME=cache)
-    out = subprocess.run([sys.executable, "-c", CHILD.format(scene=str(scene))], env=env,
+    out = subprocess.run([sys.executable, "-c", CHILD.format(scene=str(scene), scan=scan)],
+                         env=env,
                          capture_output=True, text=True, check=False)
     if out.returncode != 0:
         return {"first_iteration_s": float("nan"), "status": "failed: "
@@ -73,6 +85,8 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=2)
     parser.add_argument("--scenes", default=None, help="comma-separated names (default: all)")
     parser.add_argument("--out", type=Path, default=harness.OUT)
+    parser.add_argument("--scan-too", action="store_true",
+                        help="also a cold run with FFCx's own node lookup, side by side")
     args = parser.parse_args()
     names = (args.scenes.split(",") if args.scenes
              else sorted(p.stem for p in (ROOT / "scenes").glob("*.toml")))
@@ -86,10 +100,18 @@ def main() -> None:
         runs.append({"scene": name, "cold_s": round(cold["first_iteration_s"], 1),
                      "warm_s": round(warm_s, 2), "import_s": round(cold.get("import_s", 0), 2),
                      "status": cold["status"]})
+        if args.scan_too:
+            with tempfile.TemporaryDirectory() as cache:
+                scan = once(scene, cache, scan=True)
+            runs[-1]["cold_scan_s"] = round(scan["first_iteration_s"], 1)
+            runs[-1]["cold_ratio"] = round(cold["first_iteration_s"] / scan["first_iteration_s"], 2)
         print(runs[-1], flush=True)
-    table = harness.report("first_iteration", runs,
-                           ["scene", "cold s", "warm s (median)", "import s", "status"],
-                           ["scene", "cold_s", "warm_s", "import_s", "status"], args.out)
+    header = ["scene", "cold s", "warm s (median)", "import s", "status"]
+    columns = ["scene", "cold_s", "warm_s", "import_s", "status"]
+    if args.scan_too:
+        header += ["cold s, FFCx's scan", "cold ratio"]
+        columns += ["cold_scan_s", "cold_ratio"]
+    table = harness.report("first_iteration", runs, header, columns, args.out)
     print(table)
 
 
