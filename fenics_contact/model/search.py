@@ -7,10 +7,15 @@ oriented so that the vertex order gives the outward normal
 ``n = (b - a) x (c - a)``).
 
 Search: a k-d tree (``scipy.spatial.cKDTree``) on the facet centroids. The
-closest point of a facet lies at most ``d0 + rho`` from its centroid, with
-``d0`` the distance to the nearest centroid and ``rho`` the largest
-centroid-to-vertex distance, so every facet that can hold the closest point
-is found; the search is O(n log m) for n striker nodes and m facets.
+best of the k nearest facets (by centroid) bounds the distance d of a point
+to the surface; a facet can hold a point within d (plus the tie tolerance)
+only if its centroid lies within d + rho_f of the point, with rho_f that
+facet's centroid-to-vertex radius. The points whose k-th centroid lies
+nearer than that get every such facet from one ball query, and all
+(point, facet) candidates are projected at once in flat arrays
+(vectorised; no per-point loop and no repeated queries), so every facet
+that can hold the closest point is examined; O(n log m) for n striker nodes
+and m facets.
 
 Corner rule (documented in docs/two_bodies.md): each candidate facet's
 *clamped* closest point (the projection limited to the facet) gives a
@@ -116,17 +121,21 @@ class SurfaceSearch:
             not depend on it; only the speed does).
     """
 
-    def __init__(self, vertices: np.ndarray, candidates: int = 8) -> None:
+    def __init__(self, vertices: np.ndarray, candidates: int = 8,
+                 size: float | None = None) -> None:
         self.vertices = np.asarray(vertices, float)
         m = self.vertices.shape[0]
         if m == 0:
             raise ValueError("The target surface has no facets.")
         self.centroids = self.vertices.mean(axis=1)
-        self.rho = float(
-            np.max(np.linalg.norm(self.vertices - self.centroids[:, None, :], axis=-1))
-        )
+        #: Centroid-to-vertex radius of each facet (length).
+        self.radius = np.max(np.linalg.norm(self.vertices - self.centroids[:, None, :], axis=-1),
+                             axis=1)
+        self.rho = float(np.max(self.radius))
+        #: Length scale of the tie tolerance: the largest first edge of the facets, or
+        #: ``size`` (that of the whole surface when these facets are part of it).
         self.size = float(np.max(np.linalg.norm(
-            self.vertices[:, 1] - self.vertices[:, 0], axis=-1)))
+            self.vertices[:, 1] - self.vertices[:, 0], axis=-1))) if size is None else size
         try:
             from scipy.spatial import cKDTree
         except ImportError as err:  # pragma: no cover - depends on the install
@@ -156,25 +165,18 @@ class SurfaceSearch:
             return Projection(np.zeros(0, np.int64), np.zeros((0, gd - 1)), np.zeros(0),
                               np.zeros(0))
         m = self.vertices.shape[0]
-        facet = np.zeros(n, np.int64)
-        xi = np.zeros((n, self.vertices.shape[2] - 1))
-        dist = np.zeros(n)
-        over = np.zeros(n)
-        todo = np.arange(n)
-        k = self.k
-        # The closest point of a facet lies within rho of its centroid: once the
-        # k-th nearest centroid is farther than (best distance + rho), no other
-        # facet can be closer. Double k for the points where that fails.
-        while todo.size:
-            dist_c, idx = self.tree.query(points[todo], k=k)
-            dist_c = dist_c.reshape(todo.size, -1)
-            idx = idx.reshape(todo.size, -1)
-            f, x, d, o = self._pick(points[todo], idx)
-            facet[todo], xi[todo], dist[todo], over[todo] = f, x, d, o
-            if k >= m:
-                break
-            todo = todo[dist_c[:, -1] <= d + self.rho]
-            k = min(2 * k, m)
+        dist_c, idx = self.tree.query(points, k=self.k)
+        dist_c, idx = dist_c.reshape(n, -1), idx.reshape(n, -1)
+        facet, xi, dist, over = self._pick(points, idx)
+        # The closest point of a facet lies within rho_f of its centroid: once the
+        # k-th nearest centroid is farther than (best distance + tol + rho), no
+        # other facet can be closer or tie; the others get every such facet.
+        tol = TIE_TOL * self.size
+        if self.k < m:
+            todo = np.flatnonzero(dist_c[:, -1] <= dist + tol + self.rho)
+            if todo.size:
+                f, x, d, o = self._pick_within(points[todo], dist[todo] + tol)
+                facet[todo], xi[todo], dist[todo], over[todo] = f, x, d, o
         if previous is not None and previous.size == n:
             prev = np.asarray(previous, np.int64)
             has = prev >= 0
@@ -188,6 +190,37 @@ class SurfaceSearch:
                 facet[sel] = prev[sel]
                 xi[sel], dist[sel], over[sel] = xp[ok, 0], dp[ok, 0], op[ok, 0]
         return Projection(facet, xi, dist, over)
+
+    def _pick_within(self, points: np.ndarray, bound: np.ndarray):
+        """The corner rule over every facet that can lie within ``bound`` of each point.
+
+        One ball query gives the facets whose centroid lies within bound +
+        rho; those within bound + rho_f are projected in one flat batch, and
+        the candidates of each point are ranked by centroid distance first
+        (the k-d tree's order, which breaks exact ties as :meth:`_pick` does).
+        """
+        n = points.shape[0]
+        found = self.tree.query_ball_point(points, r=bound + self.rho, return_sorted=False)
+        counts = np.fromiter((len(f) for f in found), np.int64, n)
+        cand = np.concatenate([np.asarray(f, np.int64) for f in found]) if n else \
+            np.zeros(0, np.int64)
+        owner = np.repeat(np.arange(n), counts)
+        centre = np.linalg.norm(points[owner] - self.centroids[cand], axis=-1)
+        near = centre <= bound[owner] + self.radius[cand] * (1.0 + 1e-12)
+        owner, cand, centre = owner[near], cand[near], centre[near]
+        xi, dist, over = project(points[owner], self.vertices[cand][:, None])
+        xi, dist, over = xi[:, 0], dist[:, 0], over[:, 0]
+        order = np.lexsort((centre, owner))
+        owner, cand, xi, dist, over = owner[order], cand[order], xi[order], dist[order], \
+            over[order]
+        start = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])
+        best = np.minimum.reduceat(dist, start)
+        lengths = np.diff(np.r_[start, owner.size])
+        key = np.where(dist <= np.repeat(best, lengths) + TIE_TOL * self.size, over, np.inf)
+        # first (nearest centroid) of the least overshoot among the ties, per point
+        rank = np.lexsort((np.arange(owner.size), key, owner))
+        first = rank[start]
+        return cand[first], xi[first], dist[first], over[first]
 
     def _pick(self, points: np.ndarray, idx: np.ndarray):
         xi, dist, over = project(points, self.vertices[idx])
@@ -229,7 +262,8 @@ def _closest_points(points: np.ndarray, facets: np.ndarray) -> np.ndarray:
     return best
 
 
-def penetration_depth(points: np.ndarray, vertices: np.ndarray, candidates: int = 8) -> np.ndarray:
+def penetration_depth(points: np.ndarray, vertices: np.ndarray, candidates: int = 8,
+                      size: float | None = None) -> np.ndarray:
     """How deep each point lies inside an oriented surface, by closest point (length; 0 outside).
 
     The actual surface, not the plane of an assigned facet: the closest point
@@ -242,11 +276,12 @@ def penetration_depth(points: np.ndarray, vertices: np.ndarray, candidates: int 
         points: (n, gdim) positions.
         vertices: (m, nv, gdim) facet vertices, ordered so the normals point outward.
         candidates: nearest facets (by centroid) examined per point.
+        size: the tie tolerance's length scale (:class:`SurfaceSearch`).
     """
     points = np.asarray(points, float)
     if points.shape[0] == 0:
         return np.zeros(0)
-    search = SurfaceSearch(vertices, candidates)
+    search = SurfaceSearch(vertices, candidates, size=size)
     nearest = search.closest(points)
     k = min(max(candidates, 2 * points.shape[1]), vertices.shape[0])
     _, idx = search.tree.query(points, k=k)
