@@ -33,18 +33,27 @@ from fenics_contact.model.body import Body
 from fenics_contact.model.contact import ContactSettings, ContactSurface
 from fenics_contact.model.contacts import Contact
 from fenics_contact.model.friction import FrictionSettings, tangent_basis
-from fenics_contact.model.search import SurfaceSearch, penetration_depth
+from fenics_contact.model.search import TIE_TOL, Projection, SurfaceSearch, penetration_depth
 from fenics_contact.model.segments import node_blocks
+from fenics_contact.model.target_surface import REACH_FACETS, TargetSurface
 
 
 class DeformablePair:
     """A striker surface against a deformable target surface of the same mesh.
+
+    Each rank keeps only the target facets that can hold the closest point
+    of its striker nodes (:class:`~.target_surface.TargetSurface`): the
+    target surface is not gathered, and the kept vertices' displacements are
+    scattered from their owners. ``target_blocks``, ``vertices``,
+    ``facet_vertex`` and ``X_vertices`` describe the kept facets; the
+    assignment indexes them.
 
     Args:
         V: the displacement space (vector P1).
         u: the displacement.
         surface: the striker's contact surface (its submesh carries lam and W).
         target_facets: local facet indices of the target surface.
+        keep_all: keep the whole target surface on every rank.
     """
 
     def __init__(
@@ -53,6 +62,7 @@ class DeformablePair:
         u: fem.Function,
         surface: ContactSurface,
         target_facets: np.ndarray,
+        keep_all: bool = False,
     ) -> None:
         domain = V.mesh
         comm = domain.comm
@@ -94,24 +104,11 @@ class DeformablePair:
         else:
             nodes[flip] = nodes[flip][:, [0, 2, 1]]
         node_block = node_blocks(V)
-        im = V.dofmap.index_map
-        gblocks = im.local_to_global(node_block[nodes].reshape(-1).astype(np.int32)).reshape(
-            -1, nv
-        ) if facets.size else np.zeros((0, nv), np.int64)
-        # Target surface on every rank (O(surface) memory and traffic).
-        all_blocks = np.concatenate(comm.allgather(gblocks.astype(np.int64)))
-        all_X = np.concatenate(comm.allgather(x[nodes].reshape(-1, nv, gdim)))
-        if all_blocks.shape[0] == 0:
+        #: The target facets this rank keeps (owned ones are exchanged, never gathered).
+        self.target = TargetSurface(V, node_block[nodes].reshape(-1, nv),
+                                    x[nodes].reshape(-1, nv, gdim), keep_all=keep_all)
+        if self.target.num_global == 0:
             raise ValueError("The target facet set is empty on every rank.")
-        self.target_blocks = all_blocks  # (m, nv) global V blocks per facet vertex
-        self.vertices, self.facet_vertex = np.unique(all_blocks, return_inverse=True)
-        self.facet_vertex = self.facet_vertex.reshape(-1, nv)
-        self.X_vertices = np.zeros((self.vertices.size, gdim))
-        self.X_vertices[self.facet_vertex.reshape(-1)] = all_X.reshape(-1, gdim)
-        lo, hi = im.local_range
-        mine = (self.vertices >= lo) & (self.vertices < hi)
-        self._own_local = (self.vertices[mine] - lo).astype(np.int64)
-        self._own_pos = np.concatenate(comm.allgather(np.flatnonzero(mine)))
         # Striker nodes: W blocks on the submesh and their parent V blocks.
         self.W = fem.functionspace(surface.submesh, ("Lagrange", 1, (gdim,)))
         sub_geo = surface.submesh.geometry
@@ -130,6 +127,29 @@ class DeformablePair:
         self.version = 0
         self.search_count = 0
         self._searched_u: np.ndarray | None = None
+        self._size = self.target.facet_size(u)
+        self.target.gather(self.striker_positions(), REACH_FACETS * self._size, u)
+
+    # -- the kept target facets ----------------------------------------------------
+    @property
+    def target_blocks(self) -> np.ndarray:
+        """(m, nv) global V blocks of the kept facets' vertices."""
+        return self.target.blocks
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """The kept facets' distinct global V blocks."""
+        return self.target.vertices
+
+    @property
+    def facet_vertex(self) -> np.ndarray:
+        """(m, nv) index in :attr:`vertices` of each kept facet's vertices."""
+        return self.target.facet_vertex
+
+    @property
+    def X_vertices(self) -> np.ndarray:
+        """Reference positions of :attr:`vertices` (length)."""
+        return self.target.X_vertices
 
     def _normals(self, X: np.ndarray) -> np.ndarray:
         if self.gdim == 2:
@@ -201,13 +221,8 @@ class DeformablePair:
 
     # -- search ------------------------------------------------------------------
     def target_displacements(self, u: fem.Function | None = None) -> np.ndarray:
-        """Displacement (default: the current u) of every target vertex, on every rank."""
-        bs = self.gdim
-        values = (self.u if u is None else u).x.array.reshape(-1, bs)[self._own_local]
-        gathered = np.concatenate(self.comm.allgather(values.reshape(-1, bs)))
-        out = np.empty((self.vertices.size, bs))
-        out[self._own_pos] = gathered
-        return out
+        """Displacement (default: the current u) of every kept target vertex (collective)."""
+        return self.target.displacements(self.u if u is None else u)
 
     def striker_positions(self) -> np.ndarray:
         """Current positions of the striker nodes (owned and ghost W blocks)."""
@@ -223,9 +238,11 @@ class DeformablePair:
         if self.comm.allreduce(same, op=MPI.LAND):
             return False
         self._searched_u = self.u.x.array.copy()
-        w_t = self.target_displacements()
-        current = (self.X_vertices + w_t)[self.facet_vertex]
-        proj = self._search(current)
+        points = self.striker_positions()
+        gathers = self.target.gathers
+        w_t, proj = self._settled_search(points, lambda current: self._search(current))
+        if self.target.gathers != gathers and self.w_prev is not None:
+            self._prev_t = self.target_displacements(self._u_prev)  # new vertex numbering
         self.search_count += 1
         self.projection = proj
         facet = proj.facet
@@ -241,20 +258,48 @@ class DeformablePair:
             self.version += 1
         return changed
 
-    def _search(self, current: np.ndarray):
+    def _settled_search(self, points: np.ndarray, search) -> tuple[np.ndarray, Projection]:
+        """Run ``search(current facets)`` until the kept facets settle ``points`` (collective).
+
+        Between runs the kept box grows and the facets are exchanged again;
+        the assignment is carried over by global facet index. Returns the
+        kept vertices' displacements and the projection.
+        """
+        target = self.target
+        while True:
+            self._size = target.facet_size(self.u)
+            motion = 0.0 if target.keep_all else target.motion(self.u)
+            w_t = self.target_displacements()
+            proj = search((self.X_vertices + w_t)[self.facet_vertex])
+            tol = TIE_TOL * self._size
+            if target.covers(points, proj.distance, tol, motion):
+                return w_t, proj
+            held = (self.assignment >= 0) & (target.gid.size > 0)
+            gid = np.where(held, target.gid[np.clip(self.assignment, 0, target.gid.size - 1)], -1)
+            reach = target.reach_for(points, proj.distance, tol, REACH_FACETS * self._size)
+            target.gather(points, reach, self.u)
+            self.assignment = np.where(held, np.searchsorted(target.gid, gid), -1)
+
+    def _search(self, current: np.ndarray) -> Projection:
         """Closest target facet of every striker node (current facet vertices given)."""
-        return SurfaceSearch(current).closest(self.striker_positions(), previous=self.assignment)
+        return _closest(current, self.striker_positions(), self._size, self.assignment)
 
     def penetration(self) -> np.ndarray:
         """Depth of each owned striker node inside the current target surface (length, >= 0).
 
         Measured to the closest point of the whole target surface (collective:
-        the target surface is gathered), not to the plane of the assigned
-        facet: a node left on the extension of a facet it has passed can lie
-        inside the real surface while its gap to that plane is positive.
+        the kept facets hold it, :meth:`_settled_search`), not to the plane of
+        the assigned facet: a node left on the extension of a facet it has
+        passed can lie inside the real surface while its gap to that plane is
+        positive.
         """
-        current = (self.X_vertices + self.target_displacements())[self.facet_vertex]
-        return penetration_depth(self.striker_positions()[: self.n_owned], current)
+        points = self.striker_positions()[: self.n_owned]
+        gathers = self.target.gathers
+        w_t, _ = self._settled_search(points, lambda current: _closest(current, points, self._size))
+        if self.target.gathers != gathers and self.w_prev is not None:
+            self._prev_t = self.target_displacements(self._u_prev)
+        current = (self.X_vertices + w_t)[self.facet_vertex]
+        return penetration_depth(points, current, size=self._size)
 
     def sources(self) -> list[np.ndarray]:
         """Global V block index that each owned W block selects, one array per vertex k.
@@ -402,6 +447,20 @@ class NodeToSegmentContact(Contact):
         out.x.scatter_forward()
         vec.destroy()
         return out
+
+
+def _closest(current: np.ndarray, points: np.ndarray, size: float,
+             previous: np.ndarray | None = None) -> Projection:
+    """:meth:`SurfaceSearch.closest` of ``points`` on the facets ``current``.
+
+    With no facets (a rank that keeps none yet) every distance is inf, which
+    no kept box settles: the caller exchanges more facets.
+    """
+    n, gdim = points.shape
+    if current.shape[0] == 0:
+        return Projection(np.full(n, -1, np.int64), np.zeros((n, gdim - 1)),
+                          np.full(n, np.inf), np.zeros(n))
+    return SurfaceSearch(current, size=size).closest(points, previous=previous)
 
 
 def slip_at_projection(pair: DeformablePair, u: fem.Function, u_prev: fem.Function,

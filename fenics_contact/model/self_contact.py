@@ -178,9 +178,9 @@ class SelfContactPair(DeformablePair):
         if not (np.isfinite(neighbourhood) and neighbourhood > 0):
             raise ValueError(
                 f"neighbourhood must be finite and > 0 (facet sizes), got {neighbourhood}.")
-        super().__init__(V, u, surface, target_facets)
+        super().__init__(V, u, surface, target_facets, keep_all=True)
         # the striker's own facets, gathered like the target's (no search of its own)
-        self._striker_side = DeformablePair(V, u, surface, striker_facets)
+        self._striker_side = DeformablePair(V, u, surface, striker_facets, keep_all=True)
         own = self._striker_side
         blocks = np.concatenate([self.target_blocks, own.target_blocks])
         #: Union surface: its vertices (global V blocks) and facets (rows: target, then striker).
