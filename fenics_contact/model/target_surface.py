@@ -223,7 +223,8 @@ class TargetSurface:
             return reach
         lo, hi = points.min(axis=0), points.max(axis=0)
         for _ in range(200):
-            box = np.array([np.minimum(lo - reach, self.box[0]), np.maximum(hi + reach, self.box[1])])
+            box = np.array([np.minimum(lo - reach, self.box[0]),
+                            np.maximum(hi + reach, self.box[1])])
             if np.all(self.settled(points, distance + margin, tol, 0.0, box)):
                 return reach
             reach *= GROWTH
