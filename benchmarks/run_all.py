@@ -1,7 +1,8 @@
 """Run every benchmark in sequence (one process per case) and gather the tables.
 
 ``python benchmarks/run_all.py [--quick]
-[--only hertz2d,cost,predict,compile,first,mortar,hertz3d,ladder,mpi,speedup,inexact]``.
+[--only hertz2d,cost,predict,compile,first,mortar,hertz3d,ladder,mpi,speedup,inexact,
+twobody]``.
 The ladder's large sizes take minutes each; ``--quick`` stops at 1e5 DOFs.
 Serial and 2-rank runs of a size are run one after the other, on a machine
 that others may be using: compare them side by side, not across days.
@@ -34,6 +35,10 @@ SPEEDUP = [(1e5, 3), (1e6, 1)]
 #: (DOFs, ranks, rounds), then the inexact solver's single cases for memory per rank
 #: and the 1M-DOF point on 2 ranks beside the fixed-tolerance one.
 INEXACT = [(1e5, 1, 3), (1e5, 2, 3)]
+#: Two bodies at scale (issue 21, item 4): two hemispheres against one sphere on a
+#: plane, 1e5 DOFs, iterative solver, on 1 and then 2 ranks (each alternates the cases).
+TWO_BODY = ["--dim", "3", "--h", "0.013", "--solver", "iterative", "--steps", "4",
+            "--repeats", "3"]
 INEXACT_LADDER = [(1e5, "inexact", 1, 3), (1e5, "inexact", 2, 3), (1e6, "inexact", 2, 1),
                   (1e6, "iterative", 2, 1)]
 
@@ -57,7 +62,7 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--only",
                         default="hertz2d,cost,predict,compile,first,mortar,hertz3d,ladder,mpi,"
-                                "speedup,inexact")
+                                "speedup,inexact,twobody")
     args = parser.parse_args()
     parts = set(args.only.split(","))
     limit = 1e5 if args.quick else 1e6
@@ -93,6 +98,9 @@ def main() -> None:
     for dofs, solver, ranks, repeats in INEXACT_LADDER if "inexact" in parts else []:
         if dofs <= limit:
             ladder_case(dofs, solver, ranks, repeats)
+    for ranks in (1, 2) if "twobody" in parts else ():
+        cmd = [PYTHON, str(HERE / "performance" / "two_body.py"), *TWO_BODY]
+        call(([MPIEXEC, "-n", str(ranks)] if ranks > 1 else []) + cmd)
     if parts & {"ladder", "mpi", "speedup", "inexact"}:
         call([PYTHON, str(HERE / "performance" / "ladder3d.py"), "--table"])
 
