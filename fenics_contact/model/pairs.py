@@ -295,11 +295,12 @@ class DeformablePair:
         """
         points = self.striker_positions()[: self.n_owned]
         gathers = self.target.gathers
-        w_t, _ = self._settled_search(points, lambda current: _closest(current, points, self._size))
+        w_t, nearest = self._settled_search(points,
+                                            lambda current: _closest(current, points, self._size))
         if self.target.gathers != gathers and self.w_prev is not None:
             self._prev_t = self.target_displacements(self._u_prev)
         current = (self.X_vertices + w_t)[self.facet_vertex]
-        return penetration_depth(points, current, size=self._size)
+        return penetration_depth(points, current, size=self._size, nearest=nearest)
 
     def sources(self) -> list[np.ndarray]:
         """Global V block index that each owned W block selects, one array per vertex k.

@@ -263,7 +263,8 @@ def _closest_points(points: np.ndarray, facets: np.ndarray) -> np.ndarray:
 
 
 def penetration_depth(points: np.ndarray, vertices: np.ndarray, candidates: int = 8,
-                      size: float | None = None) -> np.ndarray:
+                      size: float | None = None,
+                      nearest: Projection | None = None) -> np.ndarray:
     """How deep each point lies inside an oriented surface, by closest point (length; 0 outside).
 
     The actual surface, not the plane of an assigned facet: the closest point
@@ -277,12 +278,15 @@ def penetration_depth(points: np.ndarray, vertices: np.ndarray, candidates: int 
         vertices: (m, nv, gdim) facet vertices, ordered so the normals point outward.
         candidates: nearest facets (by centroid) examined per point.
         size: the tie tolerance's length scale (:class:`SurfaceSearch`).
+        nearest: ``SurfaceSearch(vertices, candidates, size).closest(points)``
+            when the caller has it already.
     """
     points = np.asarray(points, float)
     if points.shape[0] == 0:
         return np.zeros(0)
     search = SurfaceSearch(vertices, candidates, size=size)
-    nearest = search.closest(points)
+    if nearest is None:
+        nearest = search.closest(points)
     k = min(max(candidates, 2 * points.shape[1]), vertices.shape[0])
     _, idx = search.tree.query(points, k=k)
     idx = np.asarray(idx).reshape(points.shape[0], -1)
