@@ -11,7 +11,8 @@ P^T R, P^T J P, Dirichlet elimination), and the whole kernel time.
 The two cases alternate in one process (two, one, two, one, ...; the
 machine is shared) and each figure is the median over ``--repeats`` runs;
 the per-case peak memory is the resident high-water mark of each rank
-during the case's build and solve (reset before each case). Under
+during the case's build and solve (reset before each case; it includes the
+interpreter and libraries, and whatever earlier cases left allocated). Under
 ``mpiexec -n 2`` every time is the maximum over ranks. Writes
 ``<out>/two_body[_3d][_<solver>][_np<ranks>].json`` and ``.md``.
 
@@ -23,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import gc
 import sys
 import time
 from pathlib import Path
@@ -70,6 +72,7 @@ def _peak_memory_gb() -> float:
 def _solve(build, steps: int, solver: str) -> dict:
     """Build a problem, solve ``steps`` GNRM load steps; counts, times and memory."""
     comm = MPI.COMM_WORLD
+    gc.collect()  # the previous case's objects, before the high-water mark restarts
     _reset_peak_memory()
     comm.Barrier()
     start = time.perf_counter()
