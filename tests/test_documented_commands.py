@@ -58,6 +58,14 @@ COMMANDS: dict[str, str | tuple[str, str]] = {
         "{python} benchmarks/performance/inexact_newton.py --dofs 1e3 --rounds 1 --out {out}",
     "python benchmarks/performance/ladder3d.py --table":
         "{python} benchmarks/performance/ladder3d.py --table --out {out}",
+    "python benchmarks/performance/two_body.py --dim 3 --h 0.013 --solver iterative --steps 4":
+        "{python} benchmarks/performance/two_body.py --dim 3 --h 0.1 --solver iterative "
+        "--steps 1 --repeats 1 --out {out}",
+    "mpiexec -n 2 python benchmarks/performance/two_body.py --dim 3 --h 0.013 --solver "
+    "iterative --steps 4":
+        "{mpiexec} -n 2 {python} benchmarks/performance/two_body.py --dim 3 --h 0.1 --solver "
+        "iterative --steps 1 --repeats 1 --out {out}",
+    "python benchmarks/run_all.py --only twobody": "{python} benchmarks/run_all.py --help",
     "python benchmarks/research/tradeoff.py --out results/tradeoff":
         "{python} benchmarks/research/tradeoff.py --scene bar --methods gnrm --r 1 --meshes 1 "
         "--repeats 1 --out {out}",
