@@ -274,8 +274,9 @@ class DeformablePair:
             tol = TIE_TOL * self._size
             if target.covers(points, proj.distance, tol, motion):
                 return w_t, proj
-            held = (self.assignment >= 0) & (target.gid.size > 0)
-            gid = np.where(held, target.gid[np.clip(self.assignment, 0, target.gid.size - 1)], -1)
+            held = self.assignment >= 0
+            gid = np.full(self.assignment.shape, -1, np.int64)
+            gid[held] = target.gid[self.assignment[held]]
             reach = target.reach_for(points, proj.distance, tol, REACH_FACETS * self._size)
             target.gather(points, reach, self.u)
             self.assignment = np.where(held, np.searchsorted(target.gid, gid), -1)
