@@ -547,6 +547,17 @@ def test_bodies_starting_deep_inside_each_other_are_refused(tmp_path):
         _build(_overlapping(tmp_path, 0.2))
 
 
+def test_mortar_bodies_starting_deep_inside_each_other_are_refused(tmp_path):
+    """The weighted gaps of a mortar pair measure the overlap (0.2 = 1.6 h)."""
+    path = _overlapping(tmp_path, 0.2)
+    text = path.read_text().replace('target = "target_face"',
+                                    'target = "target_face"\ndiscretisation = "mortar"')
+    path.write_text(text)
+    with pytest.raises(SceneError, match=r"the bodies start 0.2 inside each other near "
+                       r"\([0-9.]+, 0.3\), more than the striker facet size h = 0.125"):
+        _build(path)
+
+
 def test_shallow_initial_overlap_is_reported_and_runs(tmp_path):
     from fenics_contact.scene.checks import SceneWarning
 

@@ -17,6 +17,7 @@ from dolfinx import mesh
 
 from mpi4py import MPI
 
+from fenics_contact.model.mortar import MortarContact
 from fenics_contact.model.problem import PrescribedDisplacement
 from fenics_contact.model.rigid import assembly_held, free_rigid_motions
 from fenics_contact.scene.schema import PairSpec, Scene, SceneError
@@ -237,26 +238,36 @@ def held_by_closed_contacts(
 def check_initial_overlap(scene: Scene, problem: ContactProblem) -> float:
     """Refuse bodies that start inside each other deeper than the striker facet size h.
 
-    Only striker nodes whose projection falls on a target facet count, over
-    every deformable pair. A shallower overlap is resolved by the first step
-    and reported as a :class:`SceneWarning`. Returns the largest depth (length).
+    Over every deformable pair: on a node-to-segment pair the depth of the
+    striker nodes whose projection falls on a target facet; on a mortar pair
+    the weighted gaps (each striker node's normal gap averaged over its
+    support). A shallower overlap is resolved by the first step and reported
+    as a :class:`SceneWarning`. Returns the largest depth (length).
     """
     deepest = 0.0
     for contact in problem.contacts:
         if contact.pair is not None:
-            deepest = max(deepest, _pair_overlap(scene, contact))
+            depth = _projected_depth(contact)
+        elif isinstance(contact, MortarContact):
+            depth = np.maximum(-contact.contact_state().gap, 0.0)
+        else:
+            continue
+        deepest = max(deepest, _refuse_deep_overlap(scene, contact, depth))
     return deepest
 
 
-def _pair_overlap(scene: Scene, contact) -> float:
-    comm = contact.comm
+def _projected_depth(contact) -> np.ndarray:
+    """Depth of each striker node behind its target facet, 0 where it projects off the facet."""
     state = contact.contact_state()
-    n = state.gap.size
-    on_facet = contact.pair.projection.overshoot[:n] <= 1e-12
-    depth = np.where(on_facet, -state.gap, 0.0)
-    worst = int(np.argmax(depth)) if n else None
+    on_facet = contact.pair.projection.overshoot[: state.gap.size] <= 1e-12
+    return np.where(on_facet, -state.gap, 0.0)
+
+
+def _refuse_deep_overlap(scene: Scene, contact, depth: np.ndarray) -> float:
+    """Raise past the striker facet size h, warn past 1e-6 h; return the deepest node's depth."""
+    worst = int(np.argmax(depth)) if depth.size else None
     found = _first_on_any_rank(
-        comm,
+        contact.comm,
         None if worst is None or depth[worst] <= 0.0
         else (-float(depth[worst]), contact.nodal_coordinates()[worst]),
     )
