@@ -155,7 +155,9 @@ def closest_facing(
         close = dist[rows, p] <= chosen[2] + keep * length
         ok &= valid[rows, p] & (over[rows, p] <= keep) & close
         facet = np.where(ok, p, facet)
-        chosen = (facet, xi[rows, facet], dist[rows, facet], over[rows, facet])
+        # a node no facet qualifies for stays without a partner (infinite distance: lifted)
+        chosen = (facet, xi[rows, facet], np.where(lonely, np.inf, dist[rows, facet]),
+                  over[rows, facet])
     return Projection(*chosen)
 
 
