@@ -273,3 +273,15 @@ def test_one_killed_rank_stops_the_others(scene, reference, tmp_path):
     on_disk = len(read(out)["meshio"])
     assert 3 <= on_disk < STEPS
     assert_readable_steps(out, reference, on_disk)
+
+
+def test_sigterm_stops_cleanly_after_gmsh_has_meshed_the_scene(tmp_path):
+    """gmsh resets the process's signal handling; the run installs its handler again."""
+    text = (ROOT / "scenes" / "tube_crush.toml").read_text()  # a .geo mesh, 50 load steps
+    scene = tmp_path / "tube.toml"
+    scene.write_text(text.replace('"../meshes/', f'"{ROOT}/meshes/'))
+    out = tmp_path / "stopped"
+    rc, err = stop_after(scene, out, 3, signal.SIGTERM)
+    assert rc == 128 + signal.SIGTERM, err
+    assert len(err) == 1 and err[0].startswith("fenics-contact: stopped by SIGTERM after "), err
+    assert summary(out)["status"] == "interrupted"

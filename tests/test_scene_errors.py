@@ -492,6 +492,17 @@ def _blocks(tmp_path, text=BLOCKS, geo=None):
     return path
 
 
+@pytest.mark.parametrize("swap", [False, True], ids=["same", "swapped"])
+def test_two_pairs_on_the_same_surfaces_are_refused(tmp_path, swap):
+    second = ('[[pair]]\nname = "again"\nstriker = "target_face"\ntarget = "striker_face"\n'
+              if swap else '[[pair]]\nname = "again"\nstriker = "striker_face"\n'
+              'target = "target_face"\n')
+    text = BLOCKS.replace("[[dirichlet]]", second + "\n[[dirichlet]]", 1)
+    with pytest.raises(SceneError, match=r"\[\[pair\]\] 'again' joins the same .*as \[\[pair\]\] "
+                       r"'pair1'.*constrained twice"):
+        load_scene(_blocks(tmp_path, text))
+
+
 def test_pair_on_one_body_is_refused(tmp_path):
     text = BLOCKS.replace('target = "target_face"', 'target = "top"')
     with pytest.raises(SceneError, match=r"\[\[pair\]\] striker = 'striker_face' and target = "

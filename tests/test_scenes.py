@@ -131,6 +131,25 @@ def test_unknown_geo_parameter_is_named(tmp_path):
         build_mesh(load_scene(scene_file))
 
 
+def test_geo_parameter_in_the_plain_form_is_named_with_the_form_to_use(tmp_path, capsys):
+    """DefineConstant[h = 0.1] cannot be set from a scene: the message says how to declare it."""
+    from fenics_contact.cli import main
+
+    shipped = Path(__file__).parents[1] / "scenes" / "hertz_cylinder.toml"
+    geo = (shipped.parents[1] / "meshes" / "hertz_cylinder.geo").read_text()
+    plain = re.sub(r"(\w+) = \{([^,]+), Name \"Parameters/\w+\"\}", r"\1 = \2", geo)
+    assert plain != geo and "Parameters/" not in plain
+    (tmp_path / "plain.geo").write_text(plain)
+    scene_file = tmp_path / "plain.toml"
+    scene_file.write_text(shipped.read_text().replace('"../meshes/hertz_cylinder.geo"',
+                                                      f'"{tmp_path}/plain.geo"'))
+    assert main(["run", str(scene_file), "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "gmsh cannot read" not in err
+    assert re.search(r"plain.geo declares no parameter 'h_contact'.*it declares: none.*"
+                     r'DefineConstant\[h_contact = \{value, Name "Parameters/h_contact"\}\]', err), err
+
+
 def test_dirichlet_path_drives_a_one_body_scene(tmp_path):
     """A [[dirichlet]] path is followed knot by knot, not ramped to its end value."""
     import numpy as np

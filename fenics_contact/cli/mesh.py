@@ -8,20 +8,15 @@ from pathlib import Path
 
 def generate(geo: Path, out: Path, parameters: dict[str, float]) -> Path:
     """Mesh ``geo`` in its own dimension and write ``out`` (.msh, format 4.1)."""
-    import gmsh
+    from fenics_contact.scene.meshing import gmsh_session, open_geo
 
-    from fenics_contact.scene.meshing import open_geo
-
-    gmsh.initialize()
-    try:
+    with gmsh_session() as (gmsh, _):
         gmsh.option.setNumber("General.Terminal", 0)
         open_geo(gmsh, geo, parameters)
         dim = max(d for d, _ in gmsh.model.getPhysicalGroups())
         gmsh.model.mesh.generate(dim)
         out.parent.mkdir(parents=True, exist_ok=True)
         gmsh.write(str(out))
-    finally:
-        gmsh.finalize()
     return out
 
 

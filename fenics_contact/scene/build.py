@@ -43,7 +43,7 @@ from fenics_contact.scene.checks import (
     facet_owners,
     held_by_closed_contacts,
 )
-from fenics_contact.scene.meshing import mesh_on_rank, open_geo
+from fenics_contact.scene.meshing import gmsh_session, mesh_on_rank, open_geo
 from fenics_contact.scene.pairing import pairing_contacts
 from fenics_contact.scene.schema import (
     GENERATOR_TAGS,
@@ -110,26 +110,25 @@ def _physical_groups(scene: Scene, comm: MPI.Comm) -> dict[tuple[int, int], str]
 
     A file gmsh cannot read raises SceneError (on every rank) naming it.
     """
-    import gmsh
-
     groups: dict[tuple[int, int], str] = {}
     problem: str | None = None
     if comm.rank == 0:
-        started = not gmsh.isInitialized()
-        if started:
-            gmsh.initialize(interruptible=False)
-        try:
-            _open(gmsh, scene)
-            for d, t in gmsh.model.getPhysicalGroups():
-                groups[(d, t)] = gmsh.model.getPhysicalName(d, t)
-        except Exception as exc:  # gmsh raises bare Exception
-            message = " ".join(str(exc).split()) or type(exc).__name__
-            problem = (
-                f"{scene.path.name}: [mesh] file = {str(scene.mesh.file)!r}: gmsh cannot read "
-                f"it ({message}); check that it is a complete .geo/.msh file."
-            )
-        finally:
-            gmsh.finalize() if started else gmsh.model.remove()
+        with gmsh_session() as (gmsh, opened):
+            try:
+                _open(gmsh, scene)
+                for d, t in gmsh.model.getPhysicalGroups():
+                    groups[(d, t)] = gmsh.model.getPhysicalName(d, t)
+            except SceneError as exc:  # the file was read; the scene asks what it lacks
+                problem = str(exc)
+            except Exception as exc:  # gmsh raises bare Exception
+                message = " ".join(str(exc).split()) or type(exc).__name__
+                problem = (
+                    f"{scene.path.name}: [mesh] file = {str(scene.mesh.file)!r}: gmsh cannot "
+                    f"read it ({message}); check that it is a complete .geo/.msh file."
+                )
+            finally:
+                if not opened:
+                    gmsh.model.remove()
     groups, problem = comm.bcast((groups, problem), root=0)
     if problem is not None:
         raise SceneError(problem)

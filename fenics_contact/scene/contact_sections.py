@@ -177,7 +177,27 @@ def read_pairs(path: Path, data: dict[str, Any], dimension: int = 2) -> tuple[Pa
             neighbourhood=reader.number("neighbourhood", 3.0, positive=True),
             discretisation=_discretisation(reader, dimension),
         ))
+    _refuse_repeated_surfaces(path, out)
     return tuple(out)
+
+
+def _refuse_repeated_surfaces(path: Path, pairs: list[PairSpec]) -> None:
+    """Two pairs on the same two surfaces (either way round) would constrain them twice."""
+    seen: dict[frozenset, str] = {}
+    for pair in pairs:
+        key = frozenset((("s", pair.striker), ("t", pair.target)))
+        swapped = frozenset((("s", pair.target), ("t", pair.striker)))
+        other = seen.get(key) or seen.get(swapped)
+        if other is not None:
+            how = "the same" if key in seen else "the same two surfaces swapped"
+            raise SceneError(
+                f"{path.name}: [[pair]] '{pair.name}' joins {how} as [[pair]] '{other}' "
+                f"(striker {pair.striker!r}, target {pair.target!r}): the interface would be "
+                "constrained twice (a multiplier pair each way over-constrains it). Declare "
+                'each contact once; for exactness on non-matching meshes use discretisation = '
+                '"mortar".'
+            )
+        seen[key] = pair.name
 
 
 def _discretisation(reader: _Reader, dim: int) -> str:

@@ -8,13 +8,45 @@ themselves are the ``meshes/*.geo`` files, the only description of each.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import signal
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 from dolfinx.io.gmsh import MeshData, model_to_mesh
 
 from mpi4py import MPI
+
+
+@contextmanager
+def gmsh_session() -> Iterator[tuple[Any, bool]]:
+    """The gmsh module and whether this call opened the session (and will close it).
+
+    Uses the caller's session when one is open. gmsh's C++ library resets
+    the process's SIGINT and SIGTERM handling when it starts and stops,
+    behind Python's back (``signal.getsignal`` still names the Python
+    handler, which no longer runs: a SIGTERM then kills the process instead
+    of stopping the run cleanly). The Python handlers found on entry are
+    therefore installed again on exit.
+    """
+    import gmsh
+
+    handlers = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    opened = not gmsh.isInitialized()
+    if opened:
+        gmsh.initialize(interruptible=False)
+    try:
+        yield gmsh, opened
+    finally:
+        if opened:
+            gmsh.finalize()
+        for s, handler in handlers.items():
+            if handler is not None:
+                try:
+                    signal.signal(s, handler)
+                except ValueError:  # not the main thread: nothing was installed here
+                    pass
 
 
 def mesh_on_rank(
@@ -26,21 +58,16 @@ def mesh_on_rank(
     afterwards), or opens and closes its own. ``build`` must add and mesh a
     model with physical groups.
     """
-    import gmsh
+    if comm.rank != rank:
+        import gmsh
 
-    owns_session = False
-    if comm.rank == rank and not gmsh.isInitialized():
-        gmsh.initialize(interruptible=False)
-        owns_session = True
-    try:
-        if comm.rank == rank:
-            build(gmsh)
         return model_to_mesh(gmsh.model, comm, rank, gdim=gdim)
-    finally:
-        if comm.rank == rank:
-            if owns_session:
-                gmsh.finalize()
-            else:
+    with gmsh_session() as (gmsh, opened):
+        try:
+            build(gmsh)
+            return model_to_mesh(gmsh.model, comm, rank, gdim=gdim)
+        finally:
+            if not opened:
                 gmsh.model.remove()
 
 
@@ -60,9 +87,13 @@ def open_geo(gmsh: Any, path: Path | str, parameters: dict[str, float]) -> None:
         gmsh.onelab.clear()
         unknown = sorted(set(parameters) - declared)
         if unknown:
+            first = unknown[0]
             raise ValueError(
                 f"{Path(path).name} declares no parameter {', '.join(map(repr, unknown))}; "
-                f"it declares: {', '.join(sorted(declared)) or 'none'}."
+                f"it declares: {', '.join(sorted(declared)) or 'none'}. A parameter the scene "
+                f"may set is declared in the .geo as DefineConstant[{first} = {{value, Name "
+                f'"Parameters/{first}"}}]; (the plain form DefineConstant[{first} = value] '
+                "cannot be set from outside the file)."
             )
     for name, value in parameters.items():
         gmsh.onelab.setNumber(f"Parameters/{name}", [float(value)])
