@@ -1,6 +1,7 @@
 """`fenics-contact run` on shipped scenes: files on disk, XDMF read back with VTK."""
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -133,7 +134,9 @@ def test_failed_first_step_is_worded_truthfully(tmp_path, capsys, cutbacks, atte
     assert len(err) == 1
     assert err[0].startswith("fenics-contact: load step 1 of 10 did not converge (max_iterations")
     assert err[0].endswith(
-        f"after {attempts}); no load step finished, so {out} holds no solution.xdmf"
+        f"after {attempts}); no load step finished, so {out} holds no solution.xdmf. To try: "
+        'method = "auto" (it lowers its working r and line-searches where GNRM cycles); more '
+        "[solver] steps or max_cutbacks (smaller increments near the failure)."
     )
     summary = json.loads((out / "summary.json").read_text())
     assert summary["steps"][0]["cutbacks"] == cutbacks
@@ -201,3 +204,20 @@ def test_scene_solver_options_give_the_same_answer(tmp_path):
     assert forces["inexact"] == pytest.approx(forces["plain"], rel=1e-8)
     assert iterations["inexact"] <= iterations["iterative"] + 1
     assert iterations["extrapolated"] <= iterations["plain"]
+
+
+def test_penalty_penetration_is_given_in_facet_sizes_with_a_note(tmp_path, capsys):
+    """A soft penalty 'converges' with a deep penetration: the line says what it is."""
+    text = (SCENES / "paper_ex2.toml").read_text()
+    scene = tmp_path / "soft.toml"
+    scene.write_text(text.replace('method = "gnrm"', 'method = "penalty"').replace(
+        "r = 100.0", "r = 0.1"))
+    assert main(["run", str(scene), "--out", str(tmp_path / "soft"), "--no-pictures"]) == 0
+    line = [x for x in capsys.readouterr().out.splitlines() if "max penetration" in x][0]
+    depth, share = re.search(r"max penetration ([0-9.e+-]+) \(([0-9.e+-]+) h\)", line).groups()
+    assert float(share) > 1e-3 and float(depth) > 0
+    assert "the penalty method's own penetration: raise r, or use gnrm or auto" in line
+    scene.write_text(text)  # GNRM: no penetration, no note
+    assert main(["run", str(scene), "--out", str(tmp_path / "gnrm"), "--no-pictures"]) == 0
+    line = [x for x in capsys.readouterr().out.splitlines() if "max penetration" in x][0]
+    assert "penalty" not in line

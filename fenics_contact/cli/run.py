@@ -130,7 +130,8 @@ def _solve(
         failed = path.steps[-1]
         print(
             f"fenics-contact: load step {failed.step} of {steps} did not converge "
-            f"({failed.message or failed.status}); {_kept(failed.step - 1, out)}",
+            f"({failed.message or failed.status}); {_kept(failed.step - 1, out)}"
+            f"{_advice(scene, failed.status)}",
             file=sys.stderr,
         )
         return 1
@@ -140,10 +141,34 @@ def _solve(
             f"{scene.name}: converged, {s['iterations']} Newton iterations in "
             f"{s['load_steps']} steps, {s['wall_s']:.1f} s; contact force "
             f"{path.steps[-1].contact_force:.6g}, max penetration "
-            f"{path.steps[-1].max_penetration:.2e}\nWrote {out}/solution.xdmf, summary.json"
+            f"{_penetration(scene, outcome.problem, path.steps[-1].max_penetration)}"
+            f"\nWrote {out}/solution.xdmf, summary.json"
             + ("" if args.no_pictures or not scene.pictures else ", deformed.png, residuals.png")
         )
     return 0
+
+
+def _advice(scene: Scene, status: str) -> str:
+    """What to try after a failed load step (nothing for a stop that is not the solver's)."""
+    if status not in ("cycling", "diverged", "max_iterations", "inverted"):
+        return ""
+    tips = [] if scene.solver.method == "auto" else [
+        'method = "auto" (it lowers its working r and line-searches where GNRM cycles)']
+    tips.append("more [solver] steps or max_cutbacks (smaller increments near the failure)")
+    return ". To try: " + "; ".join(tips) + "."
+
+
+def _penetration(scene: Scene, problem: object, depth: float) -> str:
+    """The depth, and as a share of the contact facet size h; a note where penalty leaves it."""
+    sizes = [c.surface.h for c in getattr(problem, "contacts", ()) if hasattr(c, "surface")]
+    if not sizes or depth <= 0.0:
+        return f"{depth:.2e}"
+    h = min(sizes)
+    text = f"{depth:.2e} ({depth / h:.2g} h)"
+    if scene.solver.method == "penalty" and depth > 1e-3 * h:
+        text += (" - the penalty method's own penetration: raise r, or use gnrm or auto for "
+                 "none")
+    return text
 
 
 def register(sub: argparse._SubParsersAction) -> None:
