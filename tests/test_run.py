@@ -213,11 +213,11 @@ def test_penalty_penetration_is_given_in_facet_sizes_with_a_note(tmp_path, capsy
     scene.write_text(text.replace('method = "gnrm"', 'method = "penalty"').replace(
         "r = 100.0", "r = 0.1"))
     assert main(["run", str(scene), "--out", str(tmp_path / "soft"), "--no-pictures"]) == 0
-    line = [x for x in capsys.readouterr().out.splitlines() if "max penetration" in x][0]
+    line = next(x for x in capsys.readouterr().out.splitlines() if "max penetration" in x)
     depth, share = re.search(r"max penetration ([0-9.e+-]+) \(([0-9.e+-]+) h\)", line).groups()
     assert float(share) > 1e-3 and float(depth) > 0
     assert "the penalty method's own penetration: raise r, or use gnrm or auto" in line
     scene.write_text(text)  # GNRM: no penetration, no note
     assert main(["run", str(scene), "--out", str(tmp_path / "gnrm"), "--no-pictures"]) == 0
-    line = [x for x in capsys.readouterr().out.splitlines() if "max penetration" in x][0]
+    line = next(x for x in capsys.readouterr().out.splitlines() if "max penetration" in x)
     assert "penalty" not in line
