@@ -430,6 +430,32 @@ def test_output_folder_that_cannot_be_created_exits_2(tmp_path, capsys):
         assert f"cannot create output folder {out}: it is {words}" in err
 
 
+def test_resume_of_a_file_names_the_resume_option(tmp_path, capsys):
+    path = write(tmp_path, base())
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    assert main(["run", str(path), "--resume", str(blocker), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert f"cannot create output folder {blocker}: it is an existing file" in err
+    assert err.endswith("choose another --resume."), err
+
+
+@pytest.mark.mpi
+def test_a_scene_error_is_printed_once_on_two_processes(tmp_path, capsys):
+    from mpi4py import MPI
+
+    folder = Path(MPI.COMM_WORLD.bcast(str(tmp_path), root=0))
+    path = folder / "bad.toml"
+    if MPI.COMM_WORLD.rank == 0:
+        write(folder, edit(solver__stpes=3)(base()), name="bad.toml")
+    MPI.COMM_WORLD.barrier()
+    assert main(["run", str(path), "--out", str(folder / "out"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    expected = 1 if MPI.COMM_WORLD.rank == 0 else 0
+    assert len(err) == expected, err
+    assert all("unknown key 'stpes'" in line for line in err)
+
+
 def test_output_folder_not_writable(tmp_path, monkeypatch):
     import tempfile
 

@@ -34,19 +34,48 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args.func(args))
     except (ValueError, FileNotFoundError, RuntimeError) as exc:
-        print(f"fenics-contact: error: {exc}", file=sys.stderr)
+        if _collective(exc):  # raised alike on every process: said once
+            if _rank() == 0:
+                print(f"fenics-contact: error: {exc}", file=sys.stderr)
+        else:
+            where = f"process {_rank()}: " if _size() > 1 else ""
+            print(f"fenics-contact: error: {where}{exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:  # Ctrl-C outside a run's clean stop (see fenics_contact.stop)
         print("fenics-contact: stopped by SIGINT", file=sys.stderr)
         return 130
 
 
+def _rank() -> int:
+    from mpi4py import MPI
+
+    return MPI.COMM_WORLD.rank
+
+
+def _size() -> int:
+    from mpi4py import MPI
+
+    return MPI.COMM_WORLD.size
+
+
+def _collective(exc: BaseException) -> bool:
+    """Scene and checkpoint errors are raised on every process together."""
+    from fenics_contact.output.checkpoint import CheckpointError
+    from fenics_contact.scene.spec import SceneError
+
+    return isinstance(exc, SceneError | CheckpointError)
+
+
 def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
-    """Scene warnings as one line, ``fenics-contact: warning: ...`` (others as usual)."""
+    """Scene warnings as one line, ``fenics-contact: warning: ...`` (others as usual).
+
+    Scene warnings are issued on every process alike and printed by the first.
+    """
     from fenics_contact.scene.build import SceneWarning
 
     if issubclass(category, SceneWarning):
-        print(f"fenics-contact: warning: {message}", file=sys.stderr)
+        if _rank() == 0:
+            print(f"fenics-contact: warning: {message}", file=sys.stderr)
     else:
         sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
 

@@ -75,7 +75,8 @@ def _run(args: argparse.Namespace) -> int:
         out: Path = args.resume or args.out or Path("results") / scene.name
         from fenics_contact.output.folders import prepare_output_folder
 
-        prepare_output_folder(out, MPI.COMM_WORLD)  # a bad --out ends here, before any mesh
+        option = "--resume" if args.resume is not None else "--out"
+        prepare_output_folder(out, MPI.COMM_WORLD, option)  # a bad folder ends here, before meshing
         finished = [_checkpoint_step(out) if args.resume is not None else 0]
         from fenics_contact.output.folders import OutputWriteError
 

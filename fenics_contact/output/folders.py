@@ -11,19 +11,20 @@ class OutputFolderError(ValueError):
     """The output folder cannot be created or written; the message names it and the fix."""
 
 
-def prepare_output_folder(out: Path, comm=None) -> Path:
+def prepare_output_folder(out: Path, comm=None, option: str = "--out") -> Path:
     """Prove that ``out`` can be created (with parents) and written, creating nothing.
 
     Raises :class:`OutputFolderError` (one line: the folder, the reason, the
-    fix) instead of the OSError a solver would meet after minutes of work.
-    With an MPI communicator, rank 0 checks and every rank raises alike.
+    fix, naming the command-line ``option`` that gave the folder) instead of
+    the OSError a solver would meet after minutes of work. With an MPI
+    communicator, rank 0 checks and every rank raises alike.
     """
     if comm is None or comm.size == 1:
-        return _prepare(Path(out))
+        return _prepare(Path(out), option)
     problem = None
     if comm.rank == 0:
         try:
-            _prepare(Path(out))
+            _prepare(Path(out), option)
         except OutputFolderError as exc:
             problem = str(exc)
     problem = comm.bcast(problem, root=0)
@@ -32,7 +33,7 @@ def prepare_output_folder(out: Path, comm=None) -> Path:
     return Path(out)
 
 
-def _prepare(out: Path) -> Path:
+def _prepare(out: Path, option: str = "--out") -> Path:
     """Check without leaving a trace: the nearest existing ancestor takes a new entry."""
     out = out.absolute()
     existing = out
@@ -42,7 +43,7 @@ def _prepare(out: Path) -> Path:
         what = "an existing file" if existing == out else f"below the file {existing}"
         raise OutputFolderError(
             f"cannot create output folder {out}: it is {what}, not a folder; "
-            "choose another --out."
+            f"choose another {option}."
         )
     try:
         probe = tempfile.mkdtemp(prefix=".write-test-", dir=existing)
@@ -51,7 +52,7 @@ def _prepare(out: Path) -> Path:
         reason = exc.strerror or type(exc).__name__
         raise OutputFolderError(
             f"cannot write to output folder {out} ({existing}: {reason}); "
-            "choose a writable --out."
+            f"choose a writable {option}."
         ) from None
     return out
 
