@@ -418,6 +418,18 @@ def test_initial_penetration_beyond_facet_size_warns(tmp_path):
         _build(write(tmp_path, scene))
 
 
+@pytest.mark.parametrize("change, fix", [
+    (edit(obstacle__normal=[0.0, -1.0]), r"normal = \[0.0, 1.0\]\?"),
+    (edit(obstacle={"type": "ball", "centre": [0.5, -1.0], "radius": 1.0, "inside": True}),
+     r"check 'inside'"),
+], ids=["plane", "ball"])
+def test_obstacle_no_candidate_facet_faces_is_refused(tmp_path, change, fix):
+    """A plane normal given the wrong way round: the body sits inside the obstacle's side."""
+    with pytest.raises(SceneError, match=r"\[\[obstacle\]\] 'obstacle': none of its candidate "
+                       r"facets faces it .*nothing can touch it; .*" + fix):
+        _build(write(tmp_path, change(base())))
+
+
 # -- output folders -----------------------------------------------------------------------
 def test_output_folder_that_cannot_be_created_exits_2(tmp_path, capsys):
     path = write(tmp_path, base())

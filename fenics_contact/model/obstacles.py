@@ -45,6 +45,10 @@ class RigidObstacle:
         """Unit normal at ``x`` pointing to the body's side (the gradient of the gap)."""
         raise NotImplementedError
 
+    def normal_value(self, x: np.ndarray) -> np.ndarray:
+        """The same normal evaluated with numpy on points of shape (n, gdim)."""
+        raise NotImplementedError
+
 
 class RigidPlane(RigidObstacle):
     """Half-space below a plane through ``point`` with outward unit ``normal``.
@@ -72,6 +76,10 @@ class RigidPlane(RigidObstacle):
     def normal_at(self, x: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
         """The plane's unit normal n (the same at every x)."""
         return self.normal
+
+    def normal_value(self, x: np.ndarray) -> np.ndarray:
+        """Numpy normal: n at every point."""
+        return np.broadcast_to(self.normal.value, np.shape(x)).copy()
 
 
 class RigidBall(RigidObstacle):
@@ -109,4 +117,11 @@ class RigidBall(RigidObstacle):
         """Radial unit normal +-(x - c)/|x - c| (minus for a cradle)."""
         d = x - self.point
         n = d / ufl.sqrt(ufl.dot(d, d))
+        return -n if self.inside else n
+
+    def normal_value(self, x: np.ndarray) -> np.ndarray:
+        """Numpy radial normal (zero at the centre)."""
+        d = x - self.point.value
+        length = np.linalg.norm(d, axis=1, keepdims=True)
+        n = np.divide(d, length, out=np.zeros_like(d), where=length > 0)
         return -n if self.inside else n

@@ -39,6 +39,7 @@ from fenics_contact.scene.checks import (
     check_bodies_held,
     check_cells,
     check_initial_overlap,
+    check_obstacles_face_their_facets,
     check_pair_surfaces,
     facet_owners,
     held_by_closed_contacts,
@@ -363,6 +364,7 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
     solid = Solid(body.domain, bodies, body.cell_tags, prescribed=prescribed,
                   tractions=tractions)
     problem = ContactProblem(solid, contacts)
+    check_obstacles_face_their_facets(scene, problem)
     check_bodies_held(scene, problem, body.cell_tags, bodies, prescribed)
     check_initial_overlap(scene, problem)
     warn_initial_penetration(scene, problem)
@@ -386,6 +388,7 @@ def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProbl
                   prescribed=prescribed, tractions=tractions)
     contacts = [obstacle_contact(scene, body, entry) for entry in scene.obstacles]
     problem = ContactProblem(solid, contacts)
+    check_obstacles_face_their_facets(scene, problem)
     check_rigid_motions(scene, problem, free, prescribed)
     warn_initial_penetration(scene, problem)
     return problem

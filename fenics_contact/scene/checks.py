@@ -172,6 +172,67 @@ def check_pair_surfaces(
         )
 
 
+def outward_facet_normals(domain: mesh.Mesh, facets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unit outward normals and centres of exterior facets (reference configuration)."""
+    gdim, tdim = domain.geometry.dim, domain.topology.dim
+    if facets.size == 0:
+        return np.zeros((0, gdim)), np.zeros((0, gdim))
+    domain.topology.create_connectivity(tdim - 1, tdim)
+    f2c = domain.topology.connectivity(tdim - 1, tdim)
+    x = domain.geometry.x[:, :gdim]
+    corners = x[mesh.entities_to_geometry(domain, tdim - 1, facets)]
+    centre = corners.mean(axis=1)
+    if gdim == 2:
+        t = corners[:, 1] - corners[:, 0]
+        n = np.stack([t[:, 1], -t[:, 0]], axis=-1)
+    else:
+        n = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    cells = np.array([f2c.links(f)[0] for f in facets], np.int64)
+    inside = x[domain.geometry.dofmaps[0][cells]].mean(axis=1)
+    flip = np.einsum("ij,ij->i", n, centre - inside) < 0
+    n[flip] *= -1.0
+    return n, centre
+
+
+def check_obstacles_face_their_facets(scene: Scene, problem: ContactProblem) -> None:
+    """Refuse an obstacle that none of its candidate facets faces (a normal turned round).
+
+    A rigid obstacle's normal points out of it, towards the body; a facet
+    that can touch it has its outward normal against the obstacle's. When
+    every candidate facet's outward normal points along the obstacle's
+    normal, nothing can ever touch: the body lies inside the obstacle's
+    side (a plane's ``normal`` given the wrong way, a ball's ``inside``
+    flag wrong), and the run would end with no contact or, with nothing
+    else holding the body, with a misleading rigid-motion error.
+    """
+    from fenics_contact.model.obstacle_contact import ObstacleContact
+    from fenics_contact.model.obstacles import RigidPlane
+
+    for contact in problem.contacts:
+        if not isinstance(contact, ObstacleContact):
+            continue
+        normal, centre = outward_facet_normals(problem.domain, contact.facets)
+        facing = np.einsum("ij,ij->i", normal, contact.obstacle.normal_value(centre)) < -1e-8
+        comm = problem.comm
+        if comm.allreduce(int(contact.facets.size), op=MPI.SUM) == 0:
+            continue
+        if comm.allreduce(bool(np.any(facing)), op=MPI.LOR):
+            continue
+        if isinstance(contact.obstacle, RigidPlane):
+            flipped = [float(-v) + 0.0 for v in contact.obstacle.normal.value]
+            fix = (f"a plane's normal points out of the obstacle, towards the body: "
+                   f"normal = {flipped}?")
+        else:
+            fix = ("a ball keeps the body outside it unless inside = true (a cradle): "
+                   "check 'inside'.")
+        raise SceneError(
+            f"{scene.path.name}: [[obstacle]] {contact.name!r}: none of its candidate facets "
+            f"faces it (their outward normals all point along the obstacle's normal), so "
+            f"nothing can touch it; {fix}"
+        )
+
+
 def check_bodies_held(
     scene: Scene,
     problem: ContactProblem,
@@ -297,5 +358,6 @@ __all__ = [
     "check_bodies_held",
     "check_cells",
     "check_initial_overlap",
+    "check_obstacles_face_their_facets",
     "check_pair_surfaces",
 ]
