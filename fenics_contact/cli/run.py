@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 from fenics_contact.stop import StopOnSignal, StopRequested
 
 if TYPE_CHECKING:
+    from fenics_contact.model.problem import ContactProblem
     from fenics_contact.scene.schema import Scene
     from fenics_contact.solvers.stepping import StepRecord
 
@@ -159,9 +160,9 @@ def _advice(scene: Scene, status: str) -> str:
     return ". To try: " + "; ".join(tips) + "."
 
 
-def _penetration(scene: Scene, problem: object, depth: float) -> str:
+def _penetration(scene: Scene, problem: ContactProblem, depth: float) -> str:
     """The depth, and as a share of the contact facet size h; a note where penalty leaves it."""
-    sizes = [c.surface.h for c in getattr(problem, "contacts", ()) if hasattr(c, "surface")]
+    sizes = [c.surface.h for c in problem.contacts]
     if not sizes or depth <= 0.0:
         return f"{depth:.2e}"
     h = min(sizes)
