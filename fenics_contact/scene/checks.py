@@ -308,12 +308,14 @@ def check_initial_overlap(scene: Scene, problem: ContactProblem) -> float:
     deepest = 0.0
     for contact in problem.contacts:
         if contact.pair is not None:
-            depth = _projected_depth(contact)
+            depth, warn_from = _projected_depth(contact), 1e-6
         elif isinstance(contact, MortarContact):
-            depth = np.maximum(-contact.contact_state().gap, 0.0)
+            # the weighted gaps of touching curved bodies read slightly negative
+            # (each side's facets cut the other's circle): warn past 1e-3 h only
+            depth, warn_from = np.maximum(-contact.contact_state().gap, 0.0), 1e-3
         else:
             continue
-        deepest = max(deepest, _refuse_deep_overlap(scene, contact, depth))
+        deepest = max(deepest, _refuse_deep_overlap(scene, contact, depth, warn_from))
     return deepest
 
 
@@ -324,8 +326,8 @@ def _projected_depth(contact) -> np.ndarray:
     return np.where(on_facet, -state.gap, 0.0)
 
 
-def _refuse_deep_overlap(scene: Scene, contact, depth: np.ndarray) -> float:
-    """Raise past the striker facet size h, warn past 1e-6 h; return the deepest node's depth."""
+def _refuse_deep_overlap(scene: Scene, contact, depth: np.ndarray, warn_from: float) -> float:
+    """Raise past the striker facet size h, warn past ``warn_from`` h; return the deepest depth."""
     worst = int(np.argmax(depth)) if depth.size else None
     found = _first_on_any_rank(
         contact.comm,
@@ -342,7 +344,7 @@ def _refuse_deep_overlap(scene: Scene, contact, depth: np.ndarray) -> float:
             f"more than the striker facet size h = {h:.4g}; move one body out of the other in "
             "the mesh and let [[dirichlet]] values bring them into contact."
         )
-    if deepest > 1e-6 * h:
+    if deepest > warn_from * h:
         warnings.warn(
             SceneWarning(
                 f"{scene.path.name}: the bodies start {deepest:.3g} ({deepest / h:.2g} h) inside "
