@@ -35,7 +35,14 @@ from scipy.sparse import coo_matrix, csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from fenics_contact.model.pairs import DeformablePair
-from fenics_contact.model.search import KEEP, TIE_TOL, Projection, facet_normals, project
+from fenics_contact.model.search import (
+    KEEP,
+    TIE_TOL,
+    Projection,
+    facet_normals,
+    penetration_depth,
+    project,
+)
 
 #: Default neighbourhood radius, in facet sizes along the surface.
 NEIGHBOURHOOD = 3.0
@@ -43,6 +50,8 @@ NEIGHBOURHOOD = 3.0
 DEPTH = 1.0
 #: Largest overshoot of a projection past its facet (local coordinate) for the facet to count.
 OVER = 0.5
+#: Nearest facets (by centroid) a node's penetration is measured on.
+CANDIDATES = 8
 
 
 def _surface_graph(X: np.ndarray, facet_vertex: np.ndarray) -> tuple[csr_matrix, float]:
@@ -153,7 +162,10 @@ def closest_facing(
         p = np.where(ok, prev, 0)
         length = np.linalg.norm(current[p, 1] - current[p, 0], axis=-1)
         close = dist[rows, p] <= chosen[2] + keep * length
-        ok &= valid[rows, p] & (over[rows, p] <= keep) & close
+        # past the end of its facet at a concave corner the node would lie inside the
+        # facet it now projects on: the hysteresis holds it only where it does not
+        deeper = signed[rows, facet] < signed[rows, p] - TIE_TOL * length
+        ok &= valid[rows, p] & (over[rows, p] <= keep) & close & ~(deeper & (over[rows, p] > 0))
         facet = np.where(ok, p, facet)
         # a node no facet qualifies for stays without a partner (infinite distance: lifted)
         chosen = (facet, xi[rows, facet], np.where(lonely, np.inf, dist[rows, facet]),
@@ -212,29 +224,54 @@ class SelfContactPair(DeformablePair):
         return super().gap(x_s) + self.lift[0]
 
     def _search(self, current: np.ndarray) -> Projection:
+        proj = closest_facing(self.striker_positions(), self._node_normals(), current,
+                              self.excluded, previous=self.assignment)
+        lift = self.lift.x.array.reshape(-1, self.gdim)
+        lift[:, 0] = np.where(np.isfinite(proj.distance), 0.0, self._lift_length)
+        return proj
+
+    def penetration(self) -> np.ndarray:
+        """Depth of each owned striker node inside the surface it may touch (length, >= 0).
+
+        Measured as for two bodies, by closest point and pseudo-normal
+        (:func:`.search.penetration_depth`), on the facets the node may touch:
+        those outside its neighbourhood that face it (the closest point of
+        the whole surface to a node on it is the node itself). Not to the
+        plane of the assigned facet: a node kept past the end of its facet by
+        the hysteresis may lie behind that plane's extension and still on
+        the next facet (a concave corner of the wall), which is no
+        penetration. Nodes without a partner (lifted) have none.
+        """
+        n = self.n_owned
+        depth = np.zeros(n)
+        current = (self.X_vertices + self.target_displacements())[self.facet_vertex]  # collective
+        node_normals = self._node_normals()[:n]  # collective
+        lifted = self.lift.x.array.reshape(-1, self.gdim)[:n, 0] > 0.0
+        todo = np.flatnonzero(~lifted)
+        if todo.size == 0:
+            return depth
+        points = self.striker_positions()[:n]
+        allowed = ~self.excluded[:n].toarray()
+        facing = np.einsum("id,jd->ij", node_normals, facet_normals(current)) < 0.0
+        centroids = current.mean(axis=1)
+        for i in todo:
+            candidates = np.flatnonzero(allowed[i] & facing[i])
+            if candidates.size == 0:
+                continue
+            near = np.linalg.norm(centroids[candidates] - points[i], axis=1)
+            candidates = candidates[np.argsort(near)[:CANDIDATES]]
+            depth[i] = penetration_depth(points[i : i + 1], current[candidates],
+                                         size=self._size)[0]
+        return depth
+
+    def _node_normals(self) -> np.ndarray:
+        """Current normal of each striker node: the sum of its surface facets' unit normals."""
         w = np.zeros_like(self._X_union)
         w[self._from_target] = self.target_displacements()
         w[self._from_striker] = self._striker_side.target_displacements()
         union = (self._X_union + w)[self.union_facets]
         normals = vertex_normals(union, self.union_facets, self.union_vertices.size)
         on = self.striker_vertex >= 0
-        point_normals = np.zeros((self.striker_vertex.size, self.gdim))
-        point_normals[on] = normals[self.striker_vertex[on]]
-        proj = closest_facing(self.striker_positions(), point_normals, current, self.excluded,
-                              previous=self.assignment)
-        lift = self.lift.x.array.reshape(-1, self.gdim)
-        lift[:, 0] = np.where(np.isfinite(proj.distance), 0.0, self._lift_length)
-        return proj
-
-    def penetration(self) -> np.ndarray:
-        """Depth of each owned striker node behind its assigned facet's plane (length, >= 0).
-
-        Measured on the assigned (facing) facet: the closest point of the whole
-        surface to a node on it is the node itself.
-        """
-        n = self.n_owned
-        current = (self.X_vertices + self.target_displacements())[self.facet_vertex]
-        facet = self.assignment[:n]
-        gap = np.einsum("ij,ij->i", self.striker_positions()[:n] - current[facet, 0],
-                        facet_normals(current)[facet])
-        return np.maximum(-(gap + self.lift.x.array.reshape(-1, self.gdim)[:n, 0]), 0.0)
+        out = np.zeros((self.striker_vertex.size, self.gdim))
+        out[on] = normals[self.striker_vertex[on]]
+        return out
