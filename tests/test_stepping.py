@@ -51,3 +51,17 @@ def test_failed_path_reports_status_and_keeps_completed_steps(tmp_path):
     xdmf = (tmp_path / "solution.xdmf").read_text()
     if MPI.COMM_WORLD.rank == 0:
         assert xdmf.count('<Attribute Name="displacement"') == len(written)
+
+
+def test_a_nan_residual_is_not_read_as_one_that_met_its_tolerance():
+    """A solve whose last residual is NaN diverged: no "the residual met its tolerance"."""
+    from types import SimpleNamespace
+
+    from fenics_contact.solvers.base import SolveResult
+    from fenics_contact.solvers.stepping import refusal
+
+    strategy = SimpleNamespace(settings=SolverSettings(atol=1e-8), problem=None)
+    nan = SolveResult(Status.DIVERGED, 2, 0, 2, [34.1, 20.5, float("nan")])
+    assert refusal(strategy, nan) is None
+    above = SolveResult(Status.DIVERGED, 2, 0, 2, [34.1, 20.5])
+    assert refusal(strategy, above) is None

@@ -234,7 +234,7 @@ def refusal(strategy: Strategy, result: SolveResult) -> str | None:
     if not result.residuals:
         return None
     tolerance = max(settings.atol, settings.rtol * result.residuals[0])
-    if result.residuals[-1] > tolerance:
+    if not result.residuals[-1] <= tolerance:  # above it, or NaN (a diverged iterate)
         return None
     check = admissibility(strategy.problem, settings,
                           exact_constraint=getattr(strategy, "exact_constraint", True))
