@@ -105,8 +105,11 @@ def _solve(
 
     steps = scene.solver.steps
     quiet = args.quiet or MPI.COMM_WORLD.rank != 0
+    # a progress bar on a terminal; in a log (no terminal) one line per load step
+    terminal = sys.stderr.isatty()
     bar = tqdm(
-        total=steps, initial=finished[0], unit="step", desc=scene.name, disable=quiet,
+        total=steps, initial=finished[0], unit="step", desc=scene.name,
+        disable=quiet or not terminal,
         bar_format="{desc}: {n_fmt}/{total_fmt} steps |{bar}| {elapsed} {postfix}",
     )
 
@@ -117,6 +120,10 @@ def _solve(
     def step(record: StepRecord) -> None:
         finished[0] = record.step
         bar.update(1)
+        if not (quiet or terminal):
+            print(f"{scene.name}: load step {record.step}/{steps} {record.status}, load factor "
+                  f"{record.load_factor:.4g}, {record.iterations} Newton iterations, contact "
+                  f"force {record.contact_force:.6g}", file=sys.stderr, flush=True)
         stop.check()
 
     stop.check()  # a signal while the scene was read
