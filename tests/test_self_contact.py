@@ -18,7 +18,7 @@ from dolfinx import fem, la
 from mpi4py import MPI
 
 from fenics_contact.model.search import facet_normals
-from fenics_contact.model.self_contact import closest_facing, neighbourhoods
+from fenics_contact.model.self_contact import closest_facing, neighbourhoods, vertex_normals
 from fenics_contact.runner import run_scene
 from fenics_contact.scene.schema import SceneError, load_scene
 
@@ -111,6 +111,25 @@ def test_the_hysteresis_does_not_hold_a_node_inside_the_next_facet_of_a_concave_
     Y = np.array([[0.0, 0.0], [-1.0, 0.0], [1.0, -0.5]])
     proj = closest_facing(point, down, Y[facets], excluded, previous=np.array([0]))
     assert proj.facet[0] == 0
+
+
+def test_the_search_in_blocks_of_points_is_the_search_at_once(monkeypatch):
+    """Memory is bounded by comparing blocks of points with every facet: same answer."""
+    import fenics_contact.model.self_contact as self_contact
+
+    X, facets = circle(40)
+    wavy = X * (1.0 + 0.2 * np.sin(3 * np.arctan2(X[:, 1], X[:, 0])))[:, None]
+    current = wavy[facets]
+    sources = np.arange(0, 40, 3)
+    points = wavy[sources] + 0.05 * np.cos(np.arange(sources.size))[:, None]
+    normals = vertex_normals(current, facets, 40)[sources]
+    excluded = neighbourhoods(wavy, facets, sources, 2.0)
+    previous = (np.arange(sources.size) * 7) % 40
+    whole = closest_facing(points, normals, current, excluded, previous=previous)
+    monkeypatch.setattr(self_contact, "PAIRS", 90)  # blocks of 2 points
+    blocks = closest_facing(points, normals, current, excluded, previous=previous)
+    for name in ("facet", "xi", "distance", "overshoot"):
+        np.testing.assert_array_equal(getattr(blocks, name), getattr(whole, name))
 
 
 @pytest.fixture(scope="module")

@@ -52,6 +52,8 @@ DEPTH = 1.0
 OVER = 0.5
 #: Nearest facets (by centroid) a node's penetration is measured on.
 CANDIDATES = 8
+#: Point-facet pairs the search compares at once (its memory: about 200 bytes a pair).
+PAIRS = 250_000
 
 
 def _surface_graph(X: np.ndarray, facet_vertex: np.ndarray) -> tuple[csr_matrix, float]:
@@ -131,6 +133,14 @@ def closest_facing(
     if n == 0:
         return Projection(np.zeros(0, np.int64), np.zeros((0, gdim - 1)), np.zeros(0),
                           np.zeros(0))
+    rows = max(1, PAIRS // max(current.shape[0], 1))
+    if n > rows:  # every point against every facet: in blocks of points, to bound the memory
+        parts = [closest_facing(points[b], point_normals[b], current, excluded[b],
+                                None if previous is None or previous.size != n else previous[b],
+                                keep, depth)
+                 for b in (slice(k, k + rows) for k in range(0, n, rows))]
+        return Projection(*(np.concatenate([getattr(q, f) for q in parts])
+                            for f in ("facet", "xi", "distance", "overshoot")))
     normals = facet_normals(current)
     allowed = ~excluded.toarray()
     facing = np.einsum("id,jd->ij", point_normals, normals) < 0.0
