@@ -40,7 +40,6 @@ from fenics_contact.model.search import (
     TIE_TOL,
     Projection,
     facet_normals,
-    penetration_depth,
     project,
 )
 
@@ -50,8 +49,6 @@ NEIGHBOURHOOD = 3.0
 DEPTH = 1.0
 #: Largest overshoot of a projection past its facet (local coordinate) for the facet to count.
 OVER = 0.5
-#: Nearest facets (by centroid) a node's penetration is measured on.
-CANDIDATES = 8
 #: Point-facet pairs the search compares at once (its memory: about 200 bytes a pair).
 PAIRS = 250_000
 
@@ -172,10 +169,7 @@ def closest_facing(
         p = np.where(ok, prev, 0)
         length = np.linalg.norm(current[p, 1] - current[p, 0], axis=-1)
         close = dist[rows, p] <= chosen[2] + keep * length
-        # past the end of its facet at a concave corner the node would lie inside the
-        # facet it now projects on: the hysteresis holds it only where it does not
-        deeper = signed[rows, facet] < signed[rows, p] - TIE_TOL * length
-        ok &= valid[rows, p] & (over[rows, p] <= keep) & close & ~(deeper & (over[rows, p] > 0))
+        ok &= valid[rows, p] & (over[rows, p] <= keep) & close
         facet = np.where(ok, p, facet)
         # a node no facet qualifies for stays without a partner (infinite distance: lifted)
         chosen = (facet, xi[rows, facet], np.where(lonely, np.inf, dist[rows, facet]),
@@ -241,38 +235,19 @@ class SelfContactPair(DeformablePair):
         return proj
 
     def penetration(self) -> np.ndarray:
-        """Depth of each owned striker node inside the surface it may touch (length, >= 0).
+        """Depth of each owned striker node behind its assigned facet's plane (length, >= 0).
 
-        Measured as for two bodies, by closest point and pseudo-normal
-        (:func:`.search.penetration_depth`), on the facets the node may touch:
-        those outside its neighbourhood that face it (the closest point of
-        the whole surface to a node on it is the node itself). Not to the
-        plane of the assigned facet: a node kept past the end of its facet by
-        the hysteresis may lie behind that plane's extension and still on
-        the next facet (a concave corner of the wall), which is no
-        penetration. Nodes without a partner (lifted) have none.
+        Measured on the assigned (facing) facet: the closest point of the whole
+        surface to a node on it is the node itself. A node kept past the end
+        of its facet at a concave corner of the wall (the hysteresis) can lie
+        inside the next facet while in front of this plane (docs/contacts.md).
         """
         n = self.n_owned
-        depth = np.zeros(n)
-        current = (self.X_vertices + self.target_displacements())[self.facet_vertex]  # collective
-        node_normals = self._node_normals()[:n]  # collective
-        lifted = self.lift.x.array.reshape(-1, self.gdim)[:n, 0] > 0.0
-        todo = np.flatnonzero(~lifted)
-        if todo.size == 0:
-            return depth
-        points = self.striker_positions()[:n]
-        allowed = ~self.excluded[:n].toarray()
-        facing = np.einsum("id,jd->ij", node_normals, facet_normals(current)) < 0.0
-        centroids = current.mean(axis=1)
-        for i in todo:
-            candidates = np.flatnonzero(allowed[i] & facing[i])
-            if candidates.size == 0:
-                continue
-            near = np.linalg.norm(centroids[candidates] - points[i], axis=1)
-            candidates = candidates[np.argsort(near)[:CANDIDATES]]
-            depth[i] = penetration_depth(points[i : i + 1], current[candidates],
-                                         size=self._size)[0]
-        return depth
+        current = (self.X_vertices + self.target_displacements())[self.facet_vertex]
+        facet = self.assignment[:n]
+        gap = np.einsum("ij,ij->i", self.striker_positions()[:n] - current[facet, 0],
+                        facet_normals(current)[facet])
+        return np.maximum(-(gap + self.lift.x.array.reshape(-1, self.gdim)[:n, 0]), 0.0)
 
     def _node_normals(self) -> np.ndarray:
         """Current normal of each striker node: the sum of its surface facets' unit normals."""
