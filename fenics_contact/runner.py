@@ -34,8 +34,42 @@ class RunOutcome:
     out: Path
 
 
-def _summary(scene: Scene, record: RunRecord) -> dict:
-    """summary.json: the scene's identity and settings, then the run record."""
+def contact_settings(problem: ContactProblem) -> dict[str, dict]:
+    """Each built contact's r (absolute and over its E/h), quadrature and bodies, by name.
+
+    Read once the problem is built, before a strategy changes r: the r the
+    run was asked for, whichever way the scene gave it.
+    """
+    used = {}
+    for c in problem.contacts:
+        r = float(c.r.value)
+        used[c.name] = {
+            "r_absolute": r, "r_relative": r / c.stiffness_scale,
+            "quadrature": c.settings.quadrature,
+            "bodies": tuple(getattr(c, "_names", (None, None))),
+        }
+    return used
+
+
+def _summary(scene: Scene, record: RunRecord, used: dict[str, dict] | None = None) -> dict:
+    """summary.json: the scene's identity and settings, then the run record.
+
+    ``bodies``, ``pairs`` (declared, then found by [pairing]) and
+    ``obstacles`` hold each one's own settings; ``used``
+    (:func:`contact_settings`) gives each contact's r as the run uses it.
+    The top-level law, E and nu are the first body's, and quadrature, mu,
+    r_absolute and r_relative the first contact's: kept for the scripts that
+    read them, they describe the scene only with one body and one contact.
+    """
+    used = used or {}
+
+    def built(name: str) -> dict:
+        c = used.get(name, {})
+        return {k: c[k] for k in ("r_absolute", "r_relative") if k in c}
+
+    declared = {p.name for p in scene.pairs} | {o.name for o in scene.obstacles}
+    automatic = [name for name in used if name not in declared]
+    pairing = scene.pairing
     return {
         "scene": scene.name,
         "scene_file": str(scene.path),
@@ -54,14 +88,31 @@ def _summary(scene: Scene, record: RunRecord) -> dict:
         "pairs": [
             {
                 "name": pair.name, "striker": pair.striker, "target": pair.target,
-                "mu": pair.mu, "steps": _contact_steps(record, pair.name, pair.mu is not None),
+                "automatic": False, "r": pair.r, "relative": pair.relative,
+                **built(pair.name), "mu": pair.mu, "tangential_r_max": pair.tangential_r_max,
+                "quadrature": used.get(pair.name, {}).get("quadrature", "nodal"),
+                "discretisation": pair.discretisation, "self_contact": pair.self_contact,
+                "steps": _contact_steps(record, pair.name, pair.mu is not None),
             }
             for pair in scene.pairs
+        ] + [
+            {
+                "name": name, "striker": used[name]["bodies"][0],
+                "target": used[name]["bodies"][1], "automatic": True,
+                "r": pairing.r, "relative": pairing.relative, **built(name),
+                "mu": pairing.mu, "tangential_r_max": pairing.tangential_r_max,
+                "quadrature": used[name]["quadrature"],
+                "discretisation": "node-to-segment", "self_contact": False,
+                "steps": _contact_steps(record, name, pairing.mu is not None),
+            }
+            for name in automatic if pairing is not None
         ],
         "obstacles": [
             {
-                "name": o.name, "type": o.obstacle.type, "tag": o.contact.tag, "r": o.contact.r,
-                "mu": o.contact.mu,
+                "name": o.name, "type": o.obstacle.type, "tag": o.contact.tag,
+                "r": o.contact.r, "relative": o.contact.relative, **built(o.name),
+                "mu": o.contact.mu, "tangential_r_max": o.contact.tangential_r_max,
+                "quadrature": o.contact.quadrature,
                 "steps": _contact_steps(record, o.name, o.contact.mu is not None),
             }
             for o in scene.obstacles
@@ -69,7 +120,7 @@ def _summary(scene: Scene, record: RunRecord) -> dict:
         "bodies": [
             {"name": b.name, "tag": b.tag, "law": b.law, "E": b.E, "nu": b.nu}
             for b in scene.bodies
-        ],
+        ] or [{"name": "body", "tag": None, "law": scene.law, "E": scene.E, "nu": scene.nu}],
     }
 
 
@@ -86,9 +137,10 @@ def _contact_steps(record: RunRecord, name: str, frictional: bool) -> list[dict]
     ]
 
 
-def _write_summary(comm: MPI.Comm, out: Path, scene: Scene, record: RunRecord) -> dict:
+def _write_summary(comm: MPI.Comm, out: Path, scene: Scene, record: RunRecord,
+                   used: dict[str, dict]) -> dict:
     """Write summary.json (rank 0); a failed write stops every process alike."""
-    summary = _summary(scene, record)
+    summary = _summary(scene, record, used)
     failure = None
     if comm.rank == 0:
         try:
@@ -120,6 +172,7 @@ def run_scene(
     run_identity = identity(scene, comm.size)
     marker = read_latest(out / "checkpoint", run_identity) if resume else None  # before building
     problem = build_problem(scene, comm)
+    used = contact_settings(problem)
     strategy = make_strategy(
         scene.solver.method, problem, scene.solver,  # a SolverSettings with stepping keys
         linear=LinearSolverSettings(
@@ -145,7 +198,7 @@ def run_scene(
         history = strategy.history if isinstance(strategy, Extrapolated) else []
         checkpoint.write(step.step, [s.to_dict() for s in record.steps], history,
                          files=writer.written)
-        _write_summary(comm, out, scene, record)
+        _write_summary(comm, out, scene, record, used)
         if on_step is not None:
             on_step(step)
 
@@ -157,11 +210,11 @@ def run_scene(
     except StopRequested:
         record.status = "interrupted"
         if comm.rank == 0:
-            write_json(out / "summary.json", _summary(scene, record))
+            write_json(out / "summary.json", _summary(scene, record, used))
         raise
     finally:
         writer.close()
-    summary = _write_summary(comm, out, scene, path)
+    summary = _write_summary(comm, out, scene, path, used)
     draw = scene.pictures if pictures is None else pictures
     if draw:
         from fenics_contact.output.pictures import deformed_contact_picture
@@ -184,4 +237,4 @@ def run_scene(
     return RunOutcome(problem, path, summary, out)
 
 
-__all__ = ["RunOutcome", "SolveResult", "run_scene"]
+__all__ = ["RunOutcome", "SolveResult", "contact_settings", "run_scene"]
