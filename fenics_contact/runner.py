@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -9,11 +10,17 @@ from pathlib import Path
 from mpi4py import MPI
 
 from fenics_contact.model.problem import ContactProblem
-from fenics_contact.output.checkpoint import CheckpointWriter, identity, read_latest, restore
+from fenics_contact.output.checkpoint import (
+    LATEST,
+    CheckpointWriter,
+    identity,
+    read_latest,
+    restore,
+)
 from fenics_contact.output.folders import agree, write_failure
 from fenics_contact.output.io import write_json
 from fenics_contact.output.paraview import write_paraview_script
-from fenics_contact.output.xdmf import StepWriter
+from fenics_contact.output.xdmf import StepWriter, finished_steps, step_files
 from fenics_contact.scene.build import build_problem
 from fenics_contact.scene.schema import Scene
 from fenics_contact.solvers import make_strategy
@@ -151,6 +158,47 @@ def _write_summary(comm: MPI.Comm, out: Path, scene: Scene, record: RunRecord,
     return summary
 
 
+#: What a run writes into its folder besides the index, the step files and the checkpoint.
+RUN_FILES = ("summary.json", "deformed.png", "residuals.png", "friction.png")
+
+
+def earlier_run(out: Path) -> int | None:
+    """The finished load steps of an earlier run in ``out`` (None when it holds none).
+
+    A run is known by its summary.json, its index (solution.xdmf), its step
+    files or its checkpoint's ``latest.json``.
+    """
+    index = out / "solution.xdmf"
+    steps = finished_steps(index)
+    marks = (out / "summary.json", index, out / "checkpoint" / LATEST)
+    if steps or step_files(index) or any(m.is_file() for m in marks):
+        return len(steps)
+    return None
+
+
+def _replace_earlier_run(comm: MPI.Comm, out: Path) -> None:
+    """Rank 0: say so when ``out`` holds an earlier run, and remove its summary and pictures.
+
+    Its step files and checkpoint go with their writers (:class:`StepWriter`,
+    :class:`CheckpointWriter`), which remove only the files they write:
+    nothing else in ``out`` is touched.
+    """
+    if comm.rank != 0:
+        return
+    steps = earlier_run(out)
+    if steps is None:
+        return
+    done = ("no finished load step" if steps == 0
+            else f"{steps} load step{'s' if steps > 1 else ''}")
+    print(f"fenics-contact: note: {out} held an earlier run ({done}); its results are replaced",
+          file=sys.stderr, flush=True)
+    for name in RUN_FILES:
+        try:
+            (out / name).unlink(missing_ok=True)
+        except OSError:  # unwritable: the run's first write names it
+            pass
+
+
 def run_scene(
     scene: Scene,
     out: Path,
@@ -165,6 +213,9 @@ def run_scene(
 
     Each converged load step is written (fields, checkpoint, summary.json)
     at once, so a failing or stopped run leaves the completed ones on disk.
+    Without ``resume``, an earlier run's files in ``out`` (its index, step
+    files, checkpoint files, summary.json and pictures) are removed first,
+    with one note on stderr; other files in ``out`` stay.
     ``resume`` continues from the checkpoint in ``out`` (after its last
     finished step); a checkpoint of another scene or process count raises
     :class:`~fenics_contact.output.checkpoint.CheckpointError`.
@@ -187,6 +238,8 @@ def run_scene(
     record = start_record(strategy)
     record.steps = [StepRecord(**r) for r in saved.records] if saved is not None else []
     first = saved.step + 1 if saved is not None else 1
+    if not resume:
+        _replace_earlier_run(comm, out)
     # an old run's checkpoint goes before its step files: never one without the other
     checkpoint = CheckpointWriter(out / "checkpoint", problem, run_identity, fresh=not resume)
     writer = StepWriter(problem, out / "solution.xdmf", scene.fields, first_step=first)
@@ -237,4 +290,5 @@ def run_scene(
     return RunOutcome(problem, path, summary, out)
 
 
-__all__ = ["RunOutcome", "SolveResult", "contact_settings", "run_scene"]
+__all__ = ["RUN_FILES", "RunOutcome", "SolveResult", "contact_settings", "earlier_run",
+           "run_scene"]
