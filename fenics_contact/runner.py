@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -9,11 +10,17 @@ from pathlib import Path
 from mpi4py import MPI
 
 from fenics_contact.model.problem import ContactProblem
-from fenics_contact.output.checkpoint import CheckpointWriter, identity, read_latest, restore
+from fenics_contact.output.checkpoint import (
+    LATEST,
+    CheckpointWriter,
+    identity,
+    read_latest,
+    restore,
+)
 from fenics_contact.output.folders import agree, write_failure
 from fenics_contact.output.io import write_json
 from fenics_contact.output.paraview import write_paraview_script
-from fenics_contact.output.xdmf import StepWriter
+from fenics_contact.output.xdmf import StepWriter, finished_steps, step_files
 from fenics_contact.scene.build import build_problem
 from fenics_contact.scene.schema import Scene
 from fenics_contact.solvers import make_strategy
@@ -34,8 +41,42 @@ class RunOutcome:
     out: Path
 
 
-def _summary(scene: Scene, record: RunRecord) -> dict:
-    """summary.json: the scene's identity and settings, then the run record."""
+def contact_settings(problem: ContactProblem) -> dict[str, dict]:
+    """Each built contact's r (absolute and over its E/h), quadrature and bodies, by name.
+
+    Read once the problem is built, before a strategy changes r: the r the
+    run was asked for, whichever way the scene gave it.
+    """
+    used = {}
+    for c in problem.contacts:
+        r = float(c.r.value)
+        used[c.name] = {
+            "r_absolute": r, "r_relative": r / c.stiffness_scale,
+            "quadrature": c.settings.quadrature,
+            "bodies": tuple(getattr(c, "_names", (None, None))),
+        }
+    return used
+
+
+def _summary(scene: Scene, record: RunRecord, used: dict[str, dict] | None = None) -> dict:
+    """summary.json: the scene's identity and settings, then the run record.
+
+    ``bodies``, ``pairs`` (declared, then found by [pairing]) and
+    ``obstacles`` hold each one's own settings; ``used``
+    (:func:`contact_settings`) gives each contact's r as the run uses it.
+    The top-level law, E and nu are the first body's, and quadrature, mu,
+    r_absolute and r_relative the first contact's: kept for the scripts that
+    read them, they describe the scene only with one body and one contact.
+    """
+    used = used or {}
+
+    def built(name: str) -> dict:
+        c = used.get(name, {})
+        return {k: c[k] for k in ("r_absolute", "r_relative") if k in c}
+
+    declared = {p.name for p in scene.pairs} | {o.name for o in scene.obstacles}
+    automatic = [name for name in used if name not in declared]
+    pairing = scene.pairing
     return {
         "scene": scene.name,
         "scene_file": str(scene.path),
@@ -54,14 +95,31 @@ def _summary(scene: Scene, record: RunRecord) -> dict:
         "pairs": [
             {
                 "name": pair.name, "striker": pair.striker, "target": pair.target,
-                "mu": pair.mu, "steps": _contact_steps(record, pair.name, pair.mu is not None),
+                "automatic": False, "r": pair.r, "relative": pair.relative,
+                **built(pair.name), "mu": pair.mu, "tangential_r_max": pair.tangential_r_max,
+                "quadrature": used.get(pair.name, {}).get("quadrature", "nodal"),
+                "discretisation": pair.discretisation, "self_contact": pair.self_contact,
+                "steps": _contact_steps(record, pair.name, pair.mu is not None),
             }
             for pair in scene.pairs
+        ] + [
+            {
+                "name": name, "striker": used[name]["bodies"][0],
+                "target": used[name]["bodies"][1], "automatic": True,
+                "r": pairing.r, "relative": pairing.relative, **built(name),
+                "mu": pairing.mu, "tangential_r_max": pairing.tangential_r_max,
+                "quadrature": used[name]["quadrature"],
+                "discretisation": "node-to-segment", "self_contact": False,
+                "steps": _contact_steps(record, name, pairing.mu is not None),
+            }
+            for name in automatic if pairing is not None
         ],
         "obstacles": [
             {
-                "name": o.name, "type": o.obstacle.type, "tag": o.contact.tag, "r": o.contact.r,
-                "mu": o.contact.mu,
+                "name": o.name, "type": o.obstacle.type, "tag": o.contact.tag,
+                "r": o.contact.r, "relative": o.contact.relative, **built(o.name),
+                "mu": o.contact.mu, "tangential_r_max": o.contact.tangential_r_max,
+                "quadrature": o.contact.quadrature,
                 "steps": _contact_steps(record, o.name, o.contact.mu is not None),
             }
             for o in scene.obstacles
@@ -69,7 +127,7 @@ def _summary(scene: Scene, record: RunRecord) -> dict:
         "bodies": [
             {"name": b.name, "tag": b.tag, "law": b.law, "E": b.E, "nu": b.nu}
             for b in scene.bodies
-        ],
+        ] or [{"name": "body", "tag": None, "law": scene.law, "E": scene.E, "nu": scene.nu}],
     }
 
 
@@ -86,9 +144,10 @@ def _contact_steps(record: RunRecord, name: str, frictional: bool) -> list[dict]
     ]
 
 
-def _write_summary(comm: MPI.Comm, out: Path, scene: Scene, record: RunRecord) -> dict:
+def _write_summary(comm: MPI.Comm, out: Path, scene: Scene, record: RunRecord,
+                   used: dict[str, dict]) -> dict:
     """Write summary.json (rank 0); a failed write stops every process alike."""
-    summary = _summary(scene, record)
+    summary = _summary(scene, record, used)
     failure = None
     if comm.rank == 0:
         try:
@@ -97,6 +156,47 @@ def _write_summary(comm: MPI.Comm, out: Path, scene: Scene, record: RunRecord) -
             failure = write_failure(exc, out / "summary.json")
     agree(comm, failure)
     return summary
+
+
+#: What a run writes into its folder besides the index, the step files and the checkpoint.
+RUN_FILES = ("summary.json", "deformed.png", "residuals.png", "friction.png")
+
+
+def earlier_run(out: Path) -> int | None:
+    """The finished load steps of an earlier run in ``out`` (None when it holds none).
+
+    A run is known by its summary.json, its index (solution.xdmf), its step
+    files or its checkpoint's ``latest.json``.
+    """
+    index = out / "solution.xdmf"
+    steps = finished_steps(index)
+    marks = (out / "summary.json", index, out / "checkpoint" / LATEST)
+    if steps or step_files(index) or any(m.is_file() for m in marks):
+        return len(steps)
+    return None
+
+
+def _replace_earlier_run(comm: MPI.Comm, out: Path) -> None:
+    """Rank 0: say so when ``out`` holds an earlier run, and remove its summary and pictures.
+
+    Its step files and checkpoint go with their writers (:class:`StepWriter`,
+    :class:`CheckpointWriter`), which remove only the files they write:
+    nothing else in ``out`` is touched.
+    """
+    if comm.rank != 0:
+        return
+    steps = earlier_run(out)
+    if steps is None:
+        return
+    done = ("no finished load step" if steps == 0
+            else f"{steps} load step{'s' if steps > 1 else ''}")
+    print(f"fenics-contact: note: {out} held an earlier run ({done}); its results are replaced",
+          file=sys.stderr, flush=True)
+    for name in RUN_FILES:
+        try:
+            (out / name).unlink(missing_ok=True)
+        except OSError:  # unwritable: the run's first write names it
+            pass
 
 
 def run_scene(
@@ -113,6 +213,9 @@ def run_scene(
 
     Each converged load step is written (fields, checkpoint, summary.json)
     at once, so a failing or stopped run leaves the completed ones on disk.
+    Without ``resume``, an earlier run's files in ``out`` (its index, step
+    files, checkpoint files, summary.json and pictures) are removed first,
+    with one note on stderr; other files in ``out`` stay.
     ``resume`` continues from the checkpoint in ``out`` (after its last
     finished step); a checkpoint of another scene or process count raises
     :class:`~fenics_contact.output.checkpoint.CheckpointError`.
@@ -120,6 +223,7 @@ def run_scene(
     run_identity = identity(scene, comm.size)
     marker = read_latest(out / "checkpoint", run_identity) if resume else None  # before building
     problem = build_problem(scene, comm)
+    used = contact_settings(problem)
     strategy = make_strategy(
         scene.solver.method, problem, scene.solver,  # a SolverSettings with stepping keys
         linear=LinearSolverSettings(
@@ -134,6 +238,8 @@ def run_scene(
     record = start_record(strategy)
     record.steps = [StepRecord(**r) for r in saved.records] if saved is not None else []
     first = saved.step + 1 if saved is not None else 1
+    if not resume:
+        _replace_earlier_run(comm, out)
     # an old run's checkpoint goes before its step files: never one without the other
     checkpoint = CheckpointWriter(out / "checkpoint", problem, run_identity, fresh=not resume)
     writer = StepWriter(problem, out / "solution.xdmf", scene.fields, first_step=first)
@@ -145,7 +251,7 @@ def run_scene(
         history = strategy.history if isinstance(strategy, Extrapolated) else []
         checkpoint.write(step.step, [s.to_dict() for s in record.steps], history,
                          files=writer.written)
-        _write_summary(comm, out, scene, record)
+        _write_summary(comm, out, scene, record, used)
         if on_step is not None:
             on_step(step)
 
@@ -157,11 +263,11 @@ def run_scene(
     except StopRequested:
         record.status = "interrupted"
         if comm.rank == 0:
-            write_json(out / "summary.json", _summary(scene, record))
+            write_json(out / "summary.json", _summary(scene, record, used))
         raise
     finally:
         writer.close()
-    summary = _write_summary(comm, out, scene, path)
+    summary = _write_summary(comm, out, scene, path, used)
     draw = scene.pictures if pictures is None else pictures
     if draw:
         from fenics_contact.output.pictures import deformed_contact_picture
@@ -184,4 +290,5 @@ def run_scene(
     return RunOutcome(problem, path, summary, out)
 
 
-__all__ = ["RunOutcome", "SolveResult", "run_scene"]
+__all__ = ["RUN_FILES", "RunOutcome", "SolveResult", "contact_settings", "earlier_run",
+           "run_scene"]

@@ -8,9 +8,11 @@ import pytest
 from mpi4py import MPI
 
 from fenics_contact.cli import main
-from fenics_contact.output.render import render_step
+from fenics_contact.output.contact_view import body_label
+from fenics_contact.output.pictures import deformed_contact_picture
+from fenics_contact.output.render import draw_step, field_labels, render_step
 from fenics_contact.runner import run_scene
-from fenics_contact.scene.schema import load_scene
+from fenics_contact.scene.schema import FIELDS, FRICTION_FIELDS, load_scene
 
 SCENES = Path(__file__).parent.parent / "scenes"
 
@@ -59,3 +61,52 @@ def test_render_mistakes_are_named(run, capsys, args, words):
 def test_render_of_a_folder_without_a_run(tmp_path, capsys):
     assert main(["render", str(tmp_path)]) == 2
     assert "holds no finished load step" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("field", "vector", "panel", "bar"), [
+    ("contact_pressure", False, "contact pressure -lam", "p = -lam"),
+    ("displacement", True, "|displacement|", "|u|"),
+    ("tangential_traction", True, "|tangential traction|", "|t_T|"),
+    ("von_mises", False, "von mises", "von Mises"),
+    ("gap", False, "gap", "gap"),
+])
+def test_field_labels_name_the_panel_in_full_and_the_bar_briefly(field, vector, panel, bar):
+    assert field_labels(field, vector) == (panel, bar)
+
+
+def test_every_written_field_has_a_bar_title_that_fits_a_3d_panel():
+    """The bar stands in the right seventh of a 3D panel: "contact pressure -lam" was cut."""
+    written = (*FIELDS, *FRICTION_FIELDS, "body_id", "target_contact_force")
+    titles = {field: field_labels(field, vector=True)[1] for field in written}
+    assert all(len(title) <= 12 for title in titles.values()), titles
+
+
+@pytest.fixture(scope="module")
+def three_blocks(tmp_path_factory):
+    """three_blocks_3d (a column of three named blocks on a floor), finished."""
+    out = tmp_path_factory.mktemp("blocks3d")
+    outcome = run_scene(load_scene(SCENES / "three_blocks_3d.toml"), out, pictures=False,
+                        comm=MPI.COMM_SELF)
+    assert outcome.path.status == "converged"
+    return outcome
+
+
+def test_3d_render_names_the_pressed_surfaces_by_their_bodies(three_blocks, tmp_path):
+    png, picture = draw_step(three_blocks.out, path=tmp_path / "p.png")
+    assert png.is_file()
+    assert [text for _, text in picture.view.labels] == ["bottom", "middle", "top"]
+    assert picture.bar == "p = -lam"
+    assert picture.panels[0] == "contact pressure -lam, seen from the partner along n"
+    _, vm = draw_step(three_blocks.out, field="von_mises", path=tmp_path / "vm.png")
+    assert vm.bar == "von Mises" and len(vm.view.labels) == 3
+
+
+def test_deformed_png_names_the_pressed_surfaces_by_their_bodies(three_blocks, tmp_path):
+    picture = deformed_contact_picture(three_blocks.problem, tmp_path / "deformed.png")
+    assert [text for _, text in picture.view.labels] == ["bottom", "middle", "top"]
+    assert picture.bar == "p = -lam"
+
+
+def test_body_labels_without_names():
+    assert (body_label(1, ()), body_label(None, ("a",)), body_label(1, ("a", "b"))) == (
+        "body 1", "body", "b")

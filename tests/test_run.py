@@ -234,3 +234,34 @@ def test_a_log_gets_one_line_per_load_step(tmp_path, capsys):
         "block-on-block-mortar: load step 2/2 converged, load factor 1, 0 Newton iterations, "
         "contact force 2.1978",
     ]
+
+
+def test_a_new_run_in_an_old_folder_replaces_only_the_runs_files(tmp_path, capsys):
+    """An earlier run's results go with one note; files the run does not write stay."""
+    text = (SCENES / "paper_ex2.toml").read_text()
+    scene = tmp_path / "ex2.toml"
+    scene.write_text(text.replace("steps = 10", "steps = 4"))
+    out = tmp_path / "out"
+    assert main(["run", str(scene), "--out", str(out), "--quiet"]) == 0
+    assert capsys.readouterr().err == ""  # a new folder: nothing to say
+    mine = [out / "notes.txt", out / "checkpoint" / "notes.txt",
+            out / "checkpoint" / "step_0004" / "mine.txt", out / "solution" / "readme.txt"]
+    for path in mine:
+        path.write_text("the user's")
+    scene.write_text(text.replace("steps = 10", "steps = 2"))
+    assert main(["run", str(scene), "--out", str(out), "--quiet", "--no-pictures"]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"fenics-contact: note: {out} held an earlier run (4 load steps); "
+                   "its results are replaced"]
+    assert all(path.read_text() == "the user's" for path in mine)
+    # the earlier run's files are gone: its later steps, checkpoint files and pictures
+    assert sorted(p.name for p in (out / "solution").iterdir()) == [
+        "readme.txt", "step_0001.h5", "step_0001.xdmf", "step_0002.h5", "step_0002.xdmf"]
+    assert sorted(p.name for p in (out / "checkpoint" / "step_0004").iterdir()) == ["mine.txt"]
+    assert sorted(p.name for p in (out / "checkpoint").iterdir()) == [
+        "latest.json", "notes.txt", "step_0002", "step_0004"]
+    assert not (out / "deformed.png").exists() and not (out / "residuals.png").exists()
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["load_steps"] == summary["steps_completed"] == 2
+    assert json.loads((out / "checkpoint" / "latest.json").read_text())["step"] == 2
+    assert len(read_xdmf(out / "solution.xdmf")) == 2

@@ -9,10 +9,11 @@ Layout (in the run's output folder)::
 Every process writes its own NumPy file of the degrees of freedom it owns
 (no parallel I/O library needed, so it works with the DOLFINx wheel and
 with any MPI). Once all have written, process 0 replaces ``latest.json``
-atomically and removes the previous step's folder, so a stop at any moment
-leaves one complete checkpoint. The owned DOF coordinates are stored too:
-a resume checks them, so a changed mesh, order or partition is refused
-rather than read into the wrong places.
+atomically and removes the previous step's files, so a stop at any moment
+leaves one complete checkpoint. Nothing else in the folder is touched: a new
+run in an old folder removes the files above and leaves any other. The owned
+DOF coordinates are stored too: a resume checks them, so a changed mesh,
+order or partition is refused rather than read into the wrong places.
 
 What must match to resume (:func:`identity`): everything of the scene that
 changes the answer, taken from the scene's dataclasses as a whole (so a new
@@ -32,7 +33,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
-import shutil
+import re
 import zipfile
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -54,6 +55,10 @@ _FREE_SCENE_KEYS = frozenset({"path", "name", "description", "fields", "pictures
 #: linear solver) may change on resume.
 _ANSWER_SOLVER_KEYS = ("method", "steps")
 LATEST = "latest.json"
+#: The names a checkpoint gives its step folders and its processes' files (nothing else
+#: in the folder is removed).
+_STEP_FOLDER = re.compile(r"step_\d{4,}")
+_RANK_FILE = re.compile(r"rank_\d{4,}\.npz")
 _KEYS = {
     "u", "load_factor", "committed_load_factor", "history_t", "history_u", "history_lam",
     "u_coordinates",
@@ -227,6 +232,43 @@ def _rank_file(folder: Path, step: int, rank: int) -> Path:
     return folder / f"step_{step:04d}" / f"rank_{rank:04d}.npz"
 
 
+def _remove_step(step_folder: Path) -> None:
+    """Remove a step folder's process files, then the folder if nothing else is left in it."""
+    try:
+        for entry in step_folder.iterdir():
+            if _RANK_FILE.fullmatch(entry.name) and entry.is_file():
+                entry.unlink(missing_ok=True)
+        step_folder.rmdir()
+    except OSError:  # another file in it, or gone already: left as it is
+        pass
+
+
+def _remove_steps(folder: Path, keep: int | None = None) -> None:
+    """Remove the process files of every step folder but step ``keep``'s."""
+    kept = None if keep is None else f"step_{keep:04d}"
+    try:
+        old = [e for e in folder.iterdir() if e.name != kept and e.is_dir()
+               and _STEP_FOLDER.fullmatch(e.name)]
+    except OSError:  # the folder went: the next write names it
+        return
+    for entry in old:
+        _remove_step(entry)
+
+
+def remove_checkpoint(folder: Path) -> None:
+    """Remove the checkpoint files in ``folder`` (``latest.json``, ``step_NNNN/rank_RRRR.npz``).
+
+    Only what a checkpoint writes: other files in the folder (and the folder) stay.
+    """
+    if not folder.is_dir():
+        return
+    try:
+        (folder / LATEST).unlink(missing_ok=True)
+    except OSError:  # unwritable: the next write names it
+        return
+    _remove_steps(folder)
+
+
 class CheckpointWriter:
     """Writes a checkpoint after each finished load step (collective).
 
@@ -234,7 +276,8 @@ class CheckpointWriter:
         folder: the checkpoint folder, e.g. ``DIR/checkpoint``.
         problem: the problem whose state is saved.
         identity: what a resume must match (see :func:`identity`).
-        fresh: remove an earlier run's checkpoint first (a new run in an old folder).
+        fresh: remove an earlier run's checkpoint files first (a new run in an old
+            folder; other files in ``folder`` stay).
     """
 
     def __init__(
@@ -246,7 +289,7 @@ class CheckpointWriter:
         comm = problem.comm
         if comm.rank == 0:
             if fresh:
-                shutil.rmtree(folder, ignore_errors=True)
+                remove_checkpoint(folder)
             folder.mkdir(parents=True, exist_ok=True)
         comm.Barrier()
         self._coordinates = {
@@ -309,9 +352,7 @@ class CheckpointWriter:
             except OSError as exc:
                 failure = write_failure(exc, self.folder / LATEST)
             else:
-                for old in self.folder.glob("step_*"):
-                    if old.name != f"step_{step:04d}":
-                        shutil.rmtree(old, ignore_errors=True)
+                _remove_steps(self.folder, keep=step)
         agree(comm, failure)
 
 
@@ -379,5 +420,5 @@ def restore(folder: Path, problem: ContactProblem, marker: dict) -> Checkpoint:
 
 __all__ = [
     "FORMAT", "Checkpoint", "CheckpointError", "CheckpointWriter", "identity", "read_latest",
-    "restore",
+    "remove_checkpoint", "restore",
 ]

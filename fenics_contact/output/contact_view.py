@@ -19,7 +19,7 @@ laid side by side. The partner is left out, so nothing hides the contact.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -45,7 +45,8 @@ class ContactView:
         surface: the pressed surfaces (PyVista PolyData, every field of the grid),
             laid out side by side and all facing +n.
         focal: the centre of the laid-out surfaces (length).
-        labels: one (position, text) per pressed surface when there are several.
+        labels: one (position, text) per pressed surface when there are several
+            (the text: its body's name, see :func:`body_label`).
     """
 
     normal: np.ndarray
@@ -70,11 +71,24 @@ class Picture:
         panels: panel titles, left to right.
         directions: per 3D panel title, the unit direction from the focal point to the camera.
         view: the 3D contact view (None in 2D or without contact).
+        bar: the colour bar's title.
     """
 
     panels: list[str] = field(default_factory=list)
     directions: dict[str, np.ndarray] = field(default_factory=dict)
     view: ContactView | None = None
+    bar: str = ""
+
+
+def body_label(body: int | None, names: Sequence[str] = ()) -> str:
+    """What a pressed surface of body number ``body`` is called: its name, else "body N".
+
+    ``body`` None: the grid has one body ("body"); ``names``: the bodies'
+    names in the order of their numbers (the scene's [[body]] blocks).
+    """
+    if body is None:
+        return "body"
+    return names[body] if 0 <= body < len(names) else f"body {body}"
 
 
 
@@ -175,13 +189,16 @@ def _piece(faces, cells: np.ndarray):
     return faces.extract_cells(cells).extract_surface(algorithm="dataset_surface")
 
 
-def contact_view(grid, margin: float = 0.4) -> ContactView | None:
+def contact_view(grid, margin: float = 0.4, body_names: Sequence[str] = ()
+                 ) -> ContactView | None:
     """The view of the pressed surfaces of the deformed ``grid``; None when nothing presses.
 
     Args:
         grid: the deformed bodies (PyVista UnstructuredGrid) with :data:`PRESSURE`.
         margin: the window around each surface's pressed nodes, as a fraction of
             their extent (at least 4 % of the body's size on each side).
+        body_names: the bodies' names by their number in :data:`BODY` (labels;
+            "body N" without).
     """
     import pyvista
 
@@ -215,7 +232,7 @@ def contact_view(grid, margin: float = 0.4) -> ContactView | None:
         piece.points = coords @ basis  # back to world axes, laid out
         cursor += float(hi[0] - lo[0] + 2 * pad[0]) * 1.15
         pieces.append(piece)
-        name = f"body {body}" if BODY in faces.cell_data else "body"
+        name = body_label(body if BODY in faces.cell_data else None, body_names)
         top = (shift + 0.5 * (lo[0] + hi[0])) * right + (
             (hi[1] if side > 0 else -lo[1]) + pad[1]) * up
         labels.append((top, name if side > 0 else f"{name}, pressed on -n (turned over)"))
@@ -316,7 +333,8 @@ Context = Callable[[object, np.ndarray], None]
 
 
 def draw_solid(grid, style: dict[str, object], *, name: str, nodal: bool = False,
-               stick_slip: bool = False, context: Context | None = None, size: int = 700):
+               stick_slip: bool = False, context: Context | None = None, size: int = 700,
+               body_names: Sequence[str] = ()):
     """The 3D panels of one picture; returns (Picture, PyVista plotter) for the caller to save.
 
     Left to right: the pressed surfaces seen from their partners along n,
@@ -332,15 +350,18 @@ def draw_solid(grid, style: dict[str, object], *, name: str, nodal: bool = False
         context: ``context(plotter, bounds)`` draws what surrounds the bodies
             (the rigid obstacles) in the last panel; bounds (2, 3), length.
         size: the height and the width of one panel in pixels.
+        body_names: the bodies' names by their number in :data:`BODY` (the labels
+            of the pressed surfaces).
     """
     import pyvista
 
-    view = contact_view(grid)
+    view = contact_view(grid, body_names=body_names)
     stick_slip = stick_slip and view is not None and STICK_SLIP in grid.point_data
     columns = 1 + (view is not None) + stick_slip
     plotter = pyvista.Plotter(off_screen=True, window_size=(size * columns, size),
                               shape=(1, columns))
-    picture = Picture(view=view)
+    bar = style.get("scalar_bar_args", {}).get("title", "")  # type: ignore[union-attr]
+    picture = Picture(view=view, bar=str(bar))
     panels: list[tuple[str, dict[str, object], bool]] = []
     if view is not None:
         panels.append((f"{name}, seen from the partner along n", style, nodal))
@@ -375,6 +396,7 @@ __all__ = [
     "ContactView",
     "Picture",
     "add_contact_panel",
+    "body_label",
     "camera_direction",
     "contact_normal",
     "contact_view",

@@ -277,7 +277,7 @@ def _plane_picture(problem: ContactProblem, grid):
     views = [(bounds, "whole body")] + [
         (zoom, "contact zone" if len(zooms) == 1 else f"contact zone {k + 1}")
         for k, zoom in enumerate(zooms)]
-    picture = Picture()
+    picture = Picture(bar=str(style["scalar_bar_args"]["title"]))  # type: ignore[index]
     for column, (window, label) in enumerate(views):
         plotter.subplot(0, column)
         plotter.add_mesh(grid.copy(), show_edges=True, edge_color="#9a9a9a", **_body_style(grid))
@@ -311,5 +311,6 @@ def _solid_picture(problem: ContactProblem, grid):
             shape = _obstacle_mesh(problem, obstacle, bounds).clip_box(tuple(near), invert=False)
             plotter.add_mesh(shape, color="#555555", opacity=0.3)
 
+    names = [b.name for b in problem.solid.bodies]
     return draw_solid(grid, _pressure_style(grid), name="contact pressure",
-                      stick_slip=True, context=obstacles)
+                      stick_slip=True, context=obstacles, body_names=names)

@@ -13,6 +13,7 @@ brings a second HDF5 library that must not meet DOLFINx's in one process.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from xml.etree import ElementTree
 
@@ -32,6 +33,39 @@ from fenics_contact.output.xdmf import finished_steps, step_folder
 _VTK_CELLS = {"Triangle": 5, "Quadrilateral": 9, "Tetrahedron": 10, "Hexahedron": 12}
 #: Colour maps: pressure dark where high (as in deformed.png), the others sequential.
 _CMAPS = {"contact_pressure": "inferno_r", "active": "cividis", "stick_slip": "cividis"}
+#: Colour-bar titles of the fields whose names are long: the bar stands in a narrow strip
+#: at the right of a 3D panel (the panel's title names the field in full).
+_BAR_TITLES = {
+    "contact_pressure": "p = -lam", "displacement": "|u|", "von_mises": "von Mises",
+    "tangential_traction": "|t_T|", "slip": "|slip|", "target_contact_force": "|f_target|",
+    "body_id": "body",
+}
+
+
+def field_labels(field: str, vector: bool = False) -> tuple[str, str]:
+    """(the panel's name of ``field``, its colour bar's title); ``vector``: drawn by magnitude.
+
+    The title is short enough for the bar's strip of a 3D panel, e.g.
+    ("contact pressure -lam", "p = -lam"), ("|tangential traction|", "|t_T|").
+    """
+    label = field.replace("_", " ")
+    if vector:
+        label = f"|{label}|"
+    if field == "contact_pressure":
+        label = "contact pressure -lam"
+    return label, _BAR_TITLES.get(field, label)
+
+
+def body_names(out: Path) -> list[str]:
+    """The bodies' names of the run in ``out``, by body number (from its summary.json).
+
+    Empty when the folder has no readable summary.json or it names no bodies.
+    """
+    try:
+        bodies = json.loads((out / "summary.json").read_text()).get("bodies", [])
+        return [str(b["name"]) for b in bodies]
+    except (OSError, ValueError, TypeError, KeyError, AttributeError):
+        return []
 
 
 def _step_file(out: Path, step: int | None) -> tuple[Path, int]:
@@ -119,21 +153,20 @@ def draw_step(
         grid.points = np.asarray(grid.points) + u[:, :3]
     data = grid.point_data if field in grid.point_data else grid.cell_data
     values = np.asarray(data[field], dtype=float)
-    label = field.replace("_", " ")
+    label, bar = field_labels(field, vector=values.ndim > 1)
     if values.ndim > 1:
         values = np.linalg.norm(values, axis=1)
-        label = f"|{label}|"
     if field == "contact_pressure":
-        values, label = -values, "contact pressure -lam"
+        values = -values
     data[label] = values
     flat = float(np.ptp(np.asarray(grid.points)[:, 2])) == 0.0
     pyvista.OFF_SCREEN = True
     pyvista.vtk_verbosity("off")
     style: dict[str, object] = {
         "scalars": label, "cmap": _CMAPS.get(field, "viridis"),
-        "scalar_bar_args": {"title": label}}
+        "scalar_bar_args": {"title": bar}}
     if flat:
-        picture = Picture(panels=[label])
+        picture = Picture(panels=[label], bar=bar)
         plotter = pyvista.Plotter(off_screen=True, window_size=window)
         plotter.add_mesh(grid, show_edges=True, edge_color="#777777", **style)
         plotter.view_xy()
@@ -145,13 +178,13 @@ def draw_step(
             grid.point_data[STICK_SLIP] = np.asarray(grid.point_data["stick_slip"])
         if "body_id" in grid.cell_data:
             grid.cell_data[BODY] = np.asarray(grid.cell_data["body_id"])
-        style["scalar_bar_args"] = {"title": label, "vertical": True, "position_x": 0.86,
+        style["scalar_bar_args"] = {"title": bar, "vertical": True, "position_x": 0.86,
                                     "position_y": 0.2, "height": 0.6}
         if field == "stick_slip":
             style = stick_slip_style()
         picture, plotter = draw_solid(
             grid, style, name=label, nodal=field in ("stick_slip", "active"),
-            size=window[1])
+            size=window[1], body_names=body_names(out))
         plotter.subplot(0, 0)
     plotter.add_text(f"{out.name}: step {chosen}, {label}", font_size=12)
     target = path or out / f"render_step_{chosen:04d}_{field}.png"
@@ -161,4 +194,4 @@ def draw_step(
     return target, picture
 
 
-__all__ = ["draw_step", "render_step"]
+__all__ = ["body_names", "draw_step", "field_labels", "render_step"]

@@ -101,6 +101,14 @@ def write_index(index: Path, grids: Sequence[ElementTree.Element]) -> None:
     tmp.replace(index)
 
 
+def step_files(index: Path) -> list[Path]:
+    """Every step file (``step_NNNN.h5`` or ``.xdmf``, whole or not) in the step folder."""
+    folder = step_folder(index)
+    if not folder.is_dir():
+        return []
+    return sorted(e for e in folder.iterdir() if _STEP.fullmatch(e.name))
+
+
 def finished_steps(index: Path) -> list[int]:
     """Step numbers whose HDF5 and XDMF files are both in the step folder, sorted."""
     found: dict[int, set[str]] = {}
