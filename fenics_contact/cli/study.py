@@ -66,7 +66,7 @@ def study_and_write(subjects: Sequence, args: argparse.Namespace) -> int:
 
     print(f"Study {first.label}: methods {','.join(args.methods)}; r = {args.r}", flush=True)
     records = study(first)
-    table = paper_table(records, limit=args.max_iterations)
+    table = paper_table(records, limit=args.max_iterations, relative=args.relative)
     print()
     print(table)
     sources: list = [(first.label, records)]
@@ -76,7 +76,8 @@ def study_and_write(subjects: Sequence, args: argparse.Namespace) -> int:
         print(f"\nStudy {other.label} (beside {first.label})", flush=True)
         sources.append((other.label, study(other)))
     if len(sources) > 1:
-        table = comparison_table(sources, args.r, args.methods, limit=args.max_iterations)
+        table = comparison_table(sources, args.r, args.methods, limit=args.max_iterations,
+                                 relative=args.relative)
         print(f"\n{first.label} beside {', '.join(label for label, _ in sources[1:])}:\n")
         print(table)
         print()
