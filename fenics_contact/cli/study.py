@@ -137,7 +137,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Run methods x r on a scene (from zero, no cut-back, one tolerance for "
         "all, as in the paper) and write study.json, study.csv, table.md and PNG plots "
         "(residual histories, iterations against r). The paper's Tables 1 and 2 beside "
-        "the published ones: benchmarks/research/paper_tables.py (make paper-tables).",
+        "the published ones: benchmarks/research/paper_tables.py (make paper-tables)."
+        " Each load step starts from the last converged state (predictor \"previous\", "
+        "whatever the scene says), so that every method starts alike: iteration counts "
+        "match `run` with predictor = \"previous\".",
     )
     study.add_argument("scene", type=Path, help="the scene file (.toml)")
     study.add_argument(
