@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -199,6 +200,34 @@ def _replace_earlier_run(comm: MPI.Comm, out: Path) -> None:
             pass
 
 
+#: atol above this share of the force unit E h^(d-1) is too loose to mean converged.
+LOOSE_ATOL = 1e-5
+
+
+def _warn_loose_tolerance(scene: Scene, problem: ContactProblem) -> None:
+    """Warn when atol (absolute, force units) is not small against the problem's forces.
+
+    Newton's test is |R| <= max(atol, rtol |R_0|) with R in force units; the
+    force unit of the problem is E h^(d-1) (h the contact facet size). With
+    a soft material in stiff units, or micro-contact in SI units, a fixed
+    atol = 1e-8 is no longer small against it and a run 'converges' early
+    to a wrong answer (2D, E = 1e-9: the penalty method stops after one
+    iteration at 30 times the right force).
+    """
+    from fenics_contact.model.scaling import force_scale
+    from fenics_contact.scene.checks import SceneWarning
+
+    unit = force_scale(problem)
+    atol = scene.solver.atol
+    if atol > LOOSE_ATOL * unit:
+        warnings.warn(SceneWarning(
+            f"{scene.path.name}: [solver] atol = {atol:g} is absolute (force units) and not "
+            f"small against this problem's force unit E h^(d-1) = {unit:.3g}: Newton may stop "
+            f"early with a wrong answer. Set atol to about {1e-10 * unit:.1g} "
+            "(1e-10 E h^(d-1), h the contact facet size)."
+        ), stacklevel=2)
+
+
 def run_scene(
     scene: Scene,
     out: Path,
@@ -224,6 +253,7 @@ def run_scene(
     marker = read_latest(out / "checkpoint", run_identity) if resume else None  # before building
     problem = build_problem(scene, comm)
     used = contact_settings(problem)
+    _warn_loose_tolerance(scene, problem)
     strategy = make_strategy(
         scene.solver.method, problem, scene.solver,  # a SolverSettings with stepping keys
         linear=LinearSolverSettings(

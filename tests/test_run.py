@@ -265,3 +265,17 @@ def test_a_new_run_in_an_old_folder_replaces_only_the_runs_files(tmp_path, capsy
     assert summary["load_steps"] == summary["steps_completed"] == 2
     assert json.loads((out / "checkpoint" / "latest.json").read_text())["step"] == 2
     assert len(read_xdmf(out / "solution.xdmf")) == 2
+
+
+def test_an_absolute_tolerance_too_loose_for_the_forces_is_warned_about(tmp_path, capsys):
+    """E = 1e-9: every residual is below atol = 1e-8 from the start; the run says so."""
+    text = (SCENES / "paper_ex2.toml").read_text()
+    scene = tmp_path / "soft.toml"
+    scene.write_text(re.sub(r"\nE = [0-9.e+]+", "\nE = 1e-9", text, count=1))
+    assert main(["run", str(scene), "--out", str(tmp_path / "soft"), "--no-pictures",
+                 "--quiet"]) == 0
+    err = capsys.readouterr().err
+    assert "[solver] atol = 1e-08 is absolute (force units) and not small" in err, err
+    assert main(["run", str(SCENES / "paper_ex2.toml"), "--out", str(tmp_path / "stiff"),
+                 "--no-pictures", "--quiet"]) == 0
+    assert "atol" not in capsys.readouterr().err

@@ -612,3 +612,15 @@ def test_shallow_initial_overlap_is_reported_and_runs(tmp_path):
 
     with pytest.warns(SceneWarning, match=r"the bodies start 0.01 \(0.08 h\) inside each other"):
         _build(_overlapping(tmp_path, 0.01))
+
+
+def test_near_incompressible_linear_elements_are_warned_about(tmp_path):
+    """nu = 0.4999 locks P1 elements: built, with a warning that names the effect and the fix."""
+    from fenics_contact.scene.checks import SceneWarning
+
+    with pytest.warns(SceneWarning, match=r"\[material\] nu = 0.4999: the linear elements lock "
+                      r".*use nu <= 0.49 where contact pressures matter"):
+        _build(write(tmp_path, edit(material__nu=0.4999)(base())))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", SceneWarning)
+        _build(write(tmp_path, edit(material__nu=0.49)(base()), name="ok.toml"))

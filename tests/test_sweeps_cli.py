@@ -120,3 +120,16 @@ def test_stability_two_body_friction_records_coulomb_ratio_and_reference(tmp_pat
     assert auto["status"] == "converged" and auto["reference_reached"] == "True"
     assert float(auto["reference_deviation"]) < 1e-10
     assert float(auto["ft_ratio"]) == pytest.approx(0.99998, abs=1e-5)
+
+
+def test_study_beside_another_scene_with_relative_r_fills_the_table(tmp_path):
+    """--relative --beside: each scene's rows at the r asked (relative to its own E/h)."""
+    code = main(["study", str(SCENES / "block_on_block.toml"), "--beside",
+                 str(SCENES / "block_on_block_mortar.toml"), "--methods", "gnrm", "--r", "0.1,10",
+                 "--relative", "--out", str(tmp_path)])
+    assert code == 0
+    lines = (tmp_path / "table.md").read_text().splitlines()
+    assert lines[0] == "| Method | source | r = 0.1 | r = 10 |"
+    rows = [line.split("|")[3:5] for line in lines[2:]]
+    assert len(rows) == 2  # one per scene, every cell an iteration count
+    assert all(cell.strip().isdigit() for row in rows for cell in row), lines

@@ -119,7 +119,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         "stability.png and per-run step records under cases/. The project's own grid of "
         "extremes (E, nu, steps, starts, meshes, friction, pairs) is "
         "benchmarks/robustness/stability_grid.py. Exit code 0, or 1 when a run ended with "
-        "an error (an exception, not a solver status).",
+        "an error (an exception, not a solver status)."
+        " Each load step starts from the last converged state (predictor \"previous\", "
+        "whatever the scene says), so that every method starts alike: iteration counts "
+        "match `run` with predictor = \"previous\".",
     )
     cmd.add_argument("scenes", nargs="+", type=Path, help="scene files (.toml)")
     cmd.add_argument("--r", type=floats, default=list(EXTREME_R),

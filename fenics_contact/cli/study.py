@@ -66,7 +66,7 @@ def study_and_write(subjects: Sequence, args: argparse.Namespace) -> int:
 
     print(f"Study {first.label}: methods {','.join(args.methods)}; r = {args.r}", flush=True)
     records = study(first)
-    table = paper_table(records, limit=args.max_iterations)
+    table = paper_table(records, limit=args.max_iterations, relative=args.relative)
     print()
     print(table)
     sources: list = [(first.label, records)]
@@ -76,7 +76,8 @@ def study_and_write(subjects: Sequence, args: argparse.Namespace) -> int:
         print(f"\nStudy {other.label} (beside {first.label})", flush=True)
         sources.append((other.label, study(other)))
     if len(sources) > 1:
-        table = comparison_table(sources, args.r, args.methods, limit=args.max_iterations)
+        table = comparison_table(sources, args.r, args.methods, limit=args.max_iterations,
+                                 relative=args.relative)
         print(f"\n{first.label} beside {', '.join(label for label, _ in sources[1:])}:\n")
         print(table)
         print()
@@ -136,7 +137,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Run methods x r on a scene (from zero, no cut-back, one tolerance for "
         "all, as in the paper) and write study.json, study.csv, table.md and PNG plots "
         "(residual histories, iterations against r). The paper's Tables 1 and 2 beside "
-        "the published ones: benchmarks/research/paper_tables.py (make paper-tables).",
+        "the published ones: benchmarks/research/paper_tables.py (make paper-tables)."
+        " Each load step starts from the last converged state (predictor \"previous\", "
+        "whatever the scene says), so that every method starts alike: iteration counts "
+        "match `run` with predictor = \"previous\".",
     )
     study.add_argument("scene", type=Path, help="the scene file (.toml)")
     study.add_argument(

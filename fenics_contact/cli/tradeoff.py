@@ -82,7 +82,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         "problem on several meshes as several scene files, coarse first); write "
         "tradeoff.json, tradeoff.csv, table.md and tradeoff.png (error against time, "
         "Pareto front marked). The project's own trade-off (Hertz, the Example 2 bar, the "
-        "sliding block with friction, three meshes each) is benchmarks/research/tradeoff.py.",
+        "sliding block with friction, three meshes each) is benchmarks/research/tradeoff.py."
+        " Each load step starts from the last converged state (predictor \"previous\", "
+        "whatever the scene says), so that every method starts alike: iteration counts "
+        "match `run` with predictor = \"previous\".",
     )
     cmd.add_argument("scenes", nargs="+", type=Path, help="scene files (.toml)")
     cmd.add_argument("--name", default=None,

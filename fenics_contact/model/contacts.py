@@ -198,8 +198,13 @@ class Contact:
         """Nodal gaps, pressures, the active set and global summaries (fresh search).
 
         With a multiplier method the pressure is the multiplier (see
-        :meth:`nodal_pressure`), so the written field, the active set and the
-        force agree at every r. Where the partner's surface is not the
+        :meth:`nodal_pressure`), so with the vertex rule the written field,
+        the active set and the force agree at every r. With the Gauss rule
+        lam is the L2 projection of the traction min(lam + r g, 0) on P1,
+        which undershoots at the edge of the zone (tensile nodal values, a
+        few per cent of the peak): the force -int lam ds is the traction's
+        resultant, and the written field, clipped to min(lam, 0), integrates
+        to up to a few per cent more. Where the partner's surface is not the
         discretisation's gap (two bodies) ``max_penetration`` is the depth
         inside the actual surface and ``constraint_penetration`` the former.
         """

@@ -43,6 +43,7 @@ from fenics_contact.scene.checks import (
     check_pair_surfaces,
     facet_owners,
     held_by_closed_contacts,
+    warn_locking,
 )
 from fenics_contact.scene.meshing import gmsh_session, mesh_on_rank, open_geo
 from fenics_contact.scene.pairing import pairing_contacts
@@ -338,6 +339,7 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
                 f"{scene.path.name}: [[body]] {i + 1} tag = {spec.tag!r} is not a cell tag of "
                 f"the mesh; available: {named or ', '.join(map(str, present))}."
             )
+        warn_locking(scene, spec.nu, f"[[body]] {spec.name!r}")
         bodies.append(Body(spec.name, tag, material(spec.law, spec.E, spec.nu)))
     prescribed, tractions = boundary_conditions(scene, body)
     contacts: list = []
@@ -384,6 +386,7 @@ def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProbl
         )
     prescribed, tractions = boundary_conditions(scene, body)
     free = free_rigid_motions(body.domain, [(p.facets, p.at(1.0)) for p in prescribed])
+    warn_locking(scene, scene.nu, "[material]")
     solid = Solid(body.domain, [Body("body", None, material(scene.law, scene.E, scene.nu))],
                   prescribed=prescribed, tractions=tractions)
     contacts = [obstacle_contact(scene, body, entry) for entry in scene.obstacles]

@@ -168,11 +168,19 @@ def cell(record: RunRecord, limit: int) -> str:
     return STATUS_WORDS[record.status].format(limit=limit)
 
 
-def paper_table(records: Sequence[RunRecord], limit: int = 500) -> str:
-    """Markdown table in the paper's layout: methods x r, updates on a second row for NUA."""
-    rs = sorted({rec.r for rec in records})
+def r_key(record: RunRecord, relative: bool = False) -> float:
+    """The r a table shows for a record: absolute, or relative to E/h (6 digits, as asked)."""
+    return float(f"{record.r_relative if relative else record.r:.6g}")
+
+
+def paper_table(records: Sequence[RunRecord], limit: int = 500, relative: bool = False) -> str:
+    """Markdown table in the paper's layout: methods x r, updates on a second row for NUA.
+
+    ``relative``: the columns are r relative to E/h (each record's own h).
+    """
+    rs = sorted({r_key(rec, relative) for rec in records})
     methods = list(dict.fromkeys(rec.method for rec in records))
-    by_key = {(rec.method, rec.r): rec for rec in records}
+    by_key = {(rec.method, r_key(rec, relative)): rec for rec in records}
     header = "| Method | " + " | ".join(f"r = {r:g}" for r in rs) + " |"
     lines = [header, "|---" * (len(rs) + 1) + "|"]
     for m in methods:
@@ -194,13 +202,14 @@ def paper_table(records: Sequence[RunRecord], limit: int = 500) -> str:
 Source = Sequence[RunRecord] | Mapping[str, Mapping[float, str]]
 
 
-def _cells(source: Source, method: str, rs: Sequence[float], limit: int) -> tuple[list, list]:
+def _cells(source: Source, method: str, rs: Sequence[float], limit: int,
+           relative: bool = False) -> tuple[list, list]:
     """Iteration cells and NUA update cells of one method from one source."""
     if isinstance(source, Mapping):
         its, ups = source.get(method, {}), source.get(f"{method} updates", {})
         return [its.get(r, "") for r in rs], [ups.get(r, "") for r in rs]
-    by_key = {(rec.method, rec.r): rec for rec in source}
-    recs = [by_key.get((method, r)) for r in rs]
+    by_key = {(rec.method, r_key(rec, relative)): rec for rec in source}
+    recs = [by_key.get((method, float(f"{r:.6g}"))) for r in rs]
     its = [cell(rec, limit) if rec is not None else "" for rec in recs]
     ups = [
         f"{rec.updates} updates"
@@ -216,13 +225,17 @@ def comparison_table(
     r_values: Sequence[float],
     methods: Sequence[str],
     limit: int = 500,
+    relative: bool = False,
 ) -> str:
-    """Markdown table with one row per method and source (ours, the paper, an analog...)."""
+    """Markdown table with one row per method and source (ours, the paper, an analog...).
+
+    ``relative``: ``r_values`` are relative to E/h (each source's own h).
+    """
     header = "| Method | source | " + " | ".join(f"r = {r:g}" for r in r_values) + " |"
     lines = [header, "|---" * (len(r_values) + 2) + "|"]
     for m in methods:
         for label, source in sources:
-            its, ups = _cells(source, m, r_values, limit)
+            its, ups = _cells(source, m, r_values, limit, relative)
             if not any(its):
                 continue
             lines.append(f"| {PAPER_NAMES.get(m, m)} | {label} | " + " | ".join(its) + " |")
