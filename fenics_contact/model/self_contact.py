@@ -35,13 +35,7 @@ from scipy.sparse import coo_matrix, csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from fenics_contact.model.pairs import DeformablePair
-from fenics_contact.model.search import (
-    KEEP,
-    TIE_TOL,
-    Projection,
-    facet_normals,
-    project,
-)
+from fenics_contact.model.search import KEEP, TIE_TOL, Projection, facet_normals, project
 
 #: Default neighbourhood radius, in facet sizes along the surface.
 NEIGHBOURHOOD = 3.0
