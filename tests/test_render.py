@@ -110,3 +110,20 @@ def test_deformed_png_names_the_pressed_surfaces_by_their_bodies(three_blocks, t
 def test_body_labels_without_names():
     assert (body_label(1, ()), body_label(None, ("a",)), body_label(1, ("a", "b"))) == (
         "body 1", "body", "b")
+
+
+def test_2d_render_adds_a_window_on_a_small_contact_zone(tmp_path):
+    """Hertz: the zone is a few per cent of the body; it gets a panel of its own (any field)."""
+    out = tmp_path / "hertz"
+    assert run_scene(load_scene(SCENES / "hertz_cylinder.toml"), out, pictures=False,
+                     comm=MPI.COMM_SELF).path.converged
+    _, picture = draw_step(out, path=tmp_path / "p.png")
+    assert picture.panels == ["contact pressure -lam", "contact pressure -lam, contact zone"]
+    _, picture = draw_step(out, field="von_mises", path=tmp_path / "v.png")
+    assert picture.panels == ["von mises", "von mises, contact zone"]
+
+
+def test_2d_render_of_a_wide_contact_zone_has_one_panel(run, tmp_path):
+    """The bar of Example 2 presses along most of its length: no window."""
+    _, picture = draw_step(run, path=tmp_path / "p.png")
+    assert picture.panels == ["contact pressure -lam"]

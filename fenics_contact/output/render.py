@@ -166,11 +166,7 @@ def draw_step(
         "scalars": label, "cmap": _CMAPS.get(field, "viridis"),
         "scalar_bar_args": {"title": bar}}
     if flat:
-        picture = Picture(panels=[label], bar=bar)
-        plotter = pyvista.Plotter(off_screen=True, window_size=window)
-        plotter.add_mesh(grid, show_edges=True, edge_color="#777777", **style)
-        plotter.view_xy()
-        plotter.camera.parallel_projection = True
+        picture, plotter = _draw_plane(grid, style, label, bar, window)
     else:
         if "contact_pressure" in grid.point_data:
             grid.point_data[PRESSURE] = -np.asarray(grid.point_data["contact_pressure"])
@@ -192,6 +188,50 @@ def draw_step(
     plotter.screenshot(str(target))
     plotter.close()
     return target, picture
+
+
+def _draw_plane(grid, style: dict, label: str, bar: str, window: tuple[int, int]):
+    """2D: the whole body, and beside it a window on each small contact zone (as deformed.png).
+
+    The zones are those of the step's contact pressure (any field is drawn
+    in them); a zone spanning more than a fifth of the body gets none.
+    """
+    import pyvista
+
+    from fenics_contact.output.pictures import _contact_lines, _contact_zones, _frame
+
+    bounds = np.array(grid.bounds).reshape(3, 2).T
+    zooms = []
+    if "contact_pressure" in grid.point_data:
+        grid.point_data[PRESSURE] = -np.asarray(grid.point_data["contact_pressure"], float)
+        zooms = _contact_zones(grid, float(np.max(bounds[1] - bounds[0])))
+    width = window[0] * (1 + len(zooms)) // (2 if zooms else 1)
+    plotter = pyvista.Plotter(off_screen=True, window_size=(width, window[1]),
+                              shape=(1, 1 + len(zooms)))
+    views = [(bounds, label)] + [
+        (zoom, f"{label}, contact zone" + ("" if len(zooms) == 1 else f" {k + 1}"))
+        for k, zoom in enumerate(zooms)]
+    # the pressure lives on the boundary: its pressed edges drawn thick, as in deformed.png
+    pressed = None
+    if "pressure" in label and np.any(grid.point_data.get(PRESSURE, np.zeros(1)) > 0):
+        pressed = _contact_lines(grid)
+    picture = Picture(bar=bar)
+    for column, (frame, title) in enumerate(views):
+        plotter.subplot(0, column)
+        plotter.add_mesh(grid.copy(), show_edges=True, edge_color="#777777",
+                         **{**style, "show_scalar_bar": column == 0})
+        if pressed is not None and pressed.n_cells:
+            plotter.add_mesh(pressed.copy(), scalars=PRESSURE, cmap=style["cmap"],
+                             clim=[0.0, float(np.max(grid.point_data[PRESSURE]))],
+                             line_width=8 if column else 5, show_scalar_bar=False)
+        plotter.view_xy()
+        plotter.camera.parallel_projection = True
+        if zooms:
+            _frame(plotter, frame, aspect=width / (1 + len(zooms)) / window[1])
+            plotter.add_text(title, position="lower_left", font_size=10)
+        picture.panels.append(title)
+    plotter.subplot(0, 0)
+    return picture, plotter
 
 
 __all__ = ["body_names", "draw_step", "field_labels", "render_step"]
