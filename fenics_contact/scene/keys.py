@@ -173,7 +173,8 @@ KEY_DOCS: dict[str, dict[str, KeyDoc]] = {
         "z": KeyDoc(_BOUNDS, "Keep only facets whose midpoint z lies in [min, max] (3D).", "L",
                     "optional"),
         "path": KeyDoc("array of rows [t, ux, uy(, uz)]", "Piecewise-linear displacement "
-                       "against the load factor t, from t = 0 to t = 1 (instead of value).",
+                       "against the load factor t, from t = 0 to t = 1 (instead of value); "
+                       "every component is prescribed (no \"free\", unlike value).",
                        "L", "optional"),
     },
     "traction": {
