@@ -246,3 +246,28 @@ def test_mortar_sliding_across_target_vertices() -> None:
     assert np.all(np.abs(top + bottom) <= 1e-12)
     assert abs(top[0]) <= 0.005 * abs(top[1])
     assert abs(-top[1] - problem.contact_state().contact_force) <= 1e-3 * abs(top[1])
+
+
+def test_a_striker_pushed_through_the_target_in_one_step_is_refused_then_cut_back(tmp_path):
+    """2D mortar: the upper block pushed 0.3 (60 % of the lower one) in one load step.
+
+    The first Newton iterate puts the striker face deeper than the segment
+    search reaches: its nodes have no segment and would count as open, and
+    the step used to 'converge' with no contact force. The depth measured by
+    closest point refuses that iterate; after a cut-back the answer is the
+    plane-strain one, E / (1 - nu^2) x 0.3 over the unit width.
+    """
+    from fenics_contact.runner import run_scene
+    from fenics_contact.scene.schema import load_scene
+
+    shipped = Path(__file__).parents[1] / "scenes" / "block_on_block_mortar.toml"
+    text = shipped.read_text().replace('"../meshes/', f'"{shipped.parents[1]}/meshes/')
+    text = text.replace('value = ["free", -0.01]', 'value = ["free", -0.3]').replace(
+        "steps = 2", "steps = 1")
+    scene = tmp_path / "deep.toml"
+    scene.write_text(text)
+    outcome = run_scene(load_scene(scene), tmp_path / "out", comm=MPI.COMM_SELF, pictures=False)
+    assert outcome.path.converged
+    step = outcome.path.steps[-1]
+    assert step.cutbacks >= 1
+    assert step.contact_force == pytest.approx(200.0 / (1 - 0.3**2) * 0.3, rel=1e-6)

@@ -40,6 +40,7 @@ from fenics_contact.model.contact import ContactSettings, ContactSurface, assemb
 from fenics_contact.model.contacts import Contact
 from fenics_contact.model.friction import FrictionSettings
 from fenics_contact.model.mortar_friction import mortar_slip
+from fenics_contact.model.search import penetration_depth
 from fenics_contact.model.segments import (
     NEAR,
     REACH,
@@ -94,8 +95,8 @@ class MortarTransfer:
         self.sides = (left, right)
         self._idx = np.stack([np.where(nb >= 0, nb, self.me) for nb in self.sides], axis=1)
         self.slots = int(SLOTS if slots is None else slots)
-        self.reach = REACH * max(float(np.max(facet_sizes(self.striker))),
-                                 float(np.max(facet_sizes(self.target))))
+        self.striker_size = float(np.max(facet_sizes(self.striker)))
+        self.reach = REACH * max(self.striker_size, float(np.max(facet_sizes(self.target))))
         self.rows = 2 + 2 * self.slots
         self.W = fem.functionspace(sub, ("Lagrange", 1, (self.rows, 2)))
         self.M = fem.functionspace(sub, ("Lagrange", 1, (2 + self.slots,)))
@@ -161,6 +162,22 @@ class MortarTransfer:
             self.version += 1
             return True
         return False
+
+    def passed_through(self) -> np.ndarray:
+        """Depth of each owned striker node inside the target body, where it has passed through.
+
+        Closest point and pseudo-normal on the target polyline (as for
+        node-to-segment pairs). Only depths beyond half a striker facet count
+        (else 0): the weighted gaps keep a converged node within a tiny
+        fraction of h of the surface, while a node deeper than the search's
+        reach has no segment and would count as open (collective).
+        """
+        us = self.striker.displacements(self.u)
+        ut = self.target.displacements(self.u)
+        points = (self.striker.X + us)[self.me[: self.n_owned]]
+        current = (self.target.X + ut)[self.target.facet_vertex]
+        depth = penetration_depth(points, current)
+        return np.where(depth > 0.5 * self.striker_size, depth, 0.0)
 
     def _select(self, us: np.ndarray, ut: np.ndarray) -> np.ndarray:
         """The rows w = S u of every node from striker and target vertex displacements."""
@@ -413,6 +430,20 @@ class MortarContact(Contact):
     def refresh(self) -> bool:
         """Search and refill the coefficients when u has changed."""
         return self.transfer.refresh()
+
+    def penetration(self) -> float | None:
+        """2D: -min(G) of the weighted gaps, or the depth of a striker node that passed through.
+
+        A node pushed deeper than the segment search reaches has no segment
+        and counts as open; measured by closest point it is inside the
+        target body, and the solvers' acceptance test refuses the iterate
+        (``surface_tol``). 3D: None (the weighted gaps alone).
+        """
+        if self.gdim != 2:
+            return None
+        passed = float(np.max(self.mortar.passed_through(), initial=0.0))
+        weighted = float(np.max(-self.surface.nodal(self._gap_form), initial=0.0))
+        return self.comm.allreduce(max(passed, weighted), op=MPI.MAX)
 
     def target_force(self) -> fem.Function:
         """Contact force on the target's vertices, S^T dL_c/dw over the slot rows (force)."""

@@ -287,9 +287,10 @@ def _signorini_violation(contact, settings: SolverSettings, E: float) -> str | N
     two_body = state.constraint_penetration is not None
     if violation is None and two_body and inside > settings.surface_tol * h:
         violation = (f"penetration into the target surface {inside:.3g} > surface_tol * h = "
-                     f"{settings.surface_tol:g} * {h:.3g} (a striker node held on the extension "
-                     "of a target facet it has passed, as at a concave target vertex; a mortar "
-                     "pair, discretisation = \"mortar\", measures the gap on segments instead)")
+                     f"{settings.surface_tol:g} * {h:.3g} (a striker node inside the target: "
+                     "held on the extension of a facet it has passed, at a concave vertex of "
+                     "a node-to-segment target, which a mortar pair, discretisation = "
+                     "\"mortar\", avoids; or pushed through it by too large a step)")
     return violation
 
 
