@@ -279,9 +279,9 @@ def check_bodies_held(
     raise SceneError(
         f"{scene.path.name}: [[body]] {name!r}: no [[dirichlet]] condition holds "
         f"its rigid motions ({'; '.join(motions)}), and contact holds nothing before it "
-        f"closes (nor along it, frictionless). Fix: prescribe components on a face of "
-        f"{name!r} (e.g. a support, a symmetry plane or a driven face), or start it "
-        "touching the parts that hold it."
+        f"closes (nor along it: friction is not counted as a support). Fix: prescribe "
+        f"components on a face of {name!r} (e.g. a support, a symmetry plane or a driven "
+        "face), or start it touching the parts that hold it."
     )
 
 
