@@ -101,3 +101,20 @@ def test_contact_terms_are_consistent():
         pen = float(ufl.algorithms.expand_derivatives(penalty_energy(ufl.as_ufl(g), r)))
         al = float(augmented_lagrangian_energy(ufl.as_ufl(g), ufl.as_ufl(0.0), r))
         assert pen == pytest.approx(al, abs=1e-15)
+
+
+def test_round_off_multipliers_after_lift_off_are_not_contact():
+    """Every node lifted off: multipliers of 1e-30 E are round-off, not pressure."""
+    from pathlib import Path
+
+    from fenics_contact.scene.build import build_problem
+    from fenics_contact.scene.schema import load_scene
+
+    problem = build_problem(load_scene(Path(__file__).parents[1] / "scenes" / "paper_ex2.toml"))
+    contact = problem.contacts[0]
+    E = contact.modulus
+    contact.lam.x.array[:] = -1e-30 * E  # all that is left once the body came off
+    assert contact.contact_state().active_count == 0
+    assert np.all(contact.contact_state().pressure == 0.0)
+    contact.lam.x.array[:] = -1e-9 * E  # small, but a pressure
+    assert contact.contact_state().active_count > 0

@@ -172,8 +172,10 @@ class Contact:
         """Owned nodal contact pressure (<= 0, stress) of the current iterate.
 
         Multiplier strategies: the multiplier, min(lam, 0), with values
-        below 1e-12 of the largest pressure set to zero (the round-off of a
-        linear solve at open nodes). The transmitted min(lam + r g, 0) would
+        below 1e-12 of the largest pressure, or below 1e-14 E, set to zero
+        (the round-off of a linear solve at open nodes; the second also once
+        every node has lifted off, when the largest is round-off itself).
+        The transmitted min(lam + r g, 0) would
         carry the round-off r * eps * g of the gap, of the order of the
         pressure itself at r = 1e12 E/h. The penalty method, whose multiplier
         is zero, transmits r min(g, 0).
@@ -182,7 +184,7 @@ class Contact:
             return self.surface.nodal(self._pressure_form)
         pressure = np.minimum(lam, 0.0)
         peak = self.comm.allreduce(float(np.max(-pressure, initial=0.0)), op=MPI.MAX)
-        pressure[pressure > -1e-12 * peak] = 0.0
+        pressure[pressure > -max(1e-12 * peak, 1e-14 * self.modulus)] = 0.0
         return pressure
 
     def reported(self, values: np.ndarray) -> np.ndarray:
