@@ -23,6 +23,7 @@ from fenics_contact.output.io import write_json
 from fenics_contact.output.paraview import write_paraview_script
 from fenics_contact.output.xdmf import StepWriter, finished_steps, step_files
 from fenics_contact.scene.build import build_problem
+from fenics_contact.scene.checks import warn_untagged_penetration
 from fenics_contact.scene.schema import Scene
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.base import SolveResult
@@ -298,6 +299,7 @@ def run_scene(
     finally:
         writer.close()
     summary = _write_summary(comm, out, scene, path, used)
+    warn_untagged_penetration(scene, problem)
     draw = scene.pictures if pictures is None else pictures
     if draw:
         from fenics_contact.output.pictures import deformed_contact_picture

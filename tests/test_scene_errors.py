@@ -624,3 +624,20 @@ def test_near_incompressible_linear_elements_are_warned_about(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error", SceneWarning)
         _build(write(tmp_path, edit(material__nu=0.49)(base()), name="ok.toml"))
+
+
+def test_boundary_nodes_outside_the_tag_inside_an_obstacle_are_warned_about(tmp_path):
+    """Only the tagged facets are held: sides pushed through the plane are named."""
+    from fenics_contact.scene.checks import SceneWarning, warn_untagged_penetration
+
+    problem = _build(write(tmp_path, base()))
+    gdim = 2
+    problem.u.x.array.reshape(-1, gdim)[:, 1] = -0.3  # the block 0.3 into the floor
+    with pytest.warns(SceneWarning, match=r"\[\[obstacle\]\] 'obstacle': 2 boundary nodes "
+                      r"outside its candidate facets are inside it, the deepest 0.05 .*add "
+                      r"those faces to its tag, or use detect = true"):
+        assert warn_untagged_penetration(load_scene(tmp_path / "scene.toml"), problem) == 2
+    problem.u.x.array[:] = 0.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", SceneWarning)
+        assert warn_untagged_penetration(load_scene(tmp_path / "scene.toml"), problem) == 0

@@ -189,6 +189,56 @@ def warn_locking(scene: Scene, nu: float, where: str) -> None:
         )
 
 
+def warn_untagged_penetration(scene: Scene, problem: ContactProblem) -> int:
+    """Warn where boundary nodes outside an obstacle's candidate facets lie inside it.
+
+    Only the tagged facets are held by an obstacle; a face left out of the
+    tag (a side that folds over under large compression, a corner that
+    rolls) passes through it unnoticed, and the answer is wrong without a
+    failure. Checked on the current state (the end of a run); returns the
+    number of such nodes (collective).
+    """
+    from dolfinx import fem
+
+    from fenics_contact.model.obstacle_contact import ObstacleContact
+
+    domain, V, u = problem.domain, problem.V, problem.u
+    tdim, gdim = domain.topology.dim, domain.geometry.dim
+    domain.topology.create_connectivity(tdim - 1, tdim)
+    boundary = mesh.exterior_facet_indices(domain.topology)
+    owned = V.dofmap.index_map.size_local
+    X = V.tabulate_dof_coordinates()[:, :gdim]
+    x = X + u.x.array.reshape(-1, gdim)
+    on_boundary = fem.locate_dofs_topological(V, tdim - 1, boundary)
+    total = 0
+    for contact in problem.contacts:
+        if not isinstance(contact, ObstacleContact):
+            continue
+        tagged = fem.locate_dofs_topological(V, tdim - 1, contact.facets)
+        others = np.setdiff1d(on_boundary, tagged)
+        others = others[others < owned]
+        depth = -contact.obstacle.gap_value(x[others]) if others.size else np.zeros(0)
+        inside = depth > 1e-3 * contact.surface.h
+        count = problem.comm.allreduce(int(np.sum(inside)), op=MPI.SUM)
+        if count == 0:
+            continue
+        total += count
+        worst = int(np.argmax(np.where(inside, depth, -np.inf))) if np.any(inside) else None
+        found = _first_on_any_rank(
+            problem.comm, None if worst is None else (-float(depth[worst]), x[others][worst]))
+        assert found is not None
+        warnings.warn(
+            SceneWarning(
+                f"{scene.path.name}: [[obstacle]] {contact.name!r}: {count} boundary nodes "
+                f"outside its candidate facets are inside it, the deepest {-found[0]:.3g} near "
+                f"{_where(found[1], gdim)}; only the tagged facets are held: add those faces to "
+                "its tag, or use detect = true."
+            ),
+            stacklevel=2,
+        )
+    return total
+
+
 def outward_facet_normals(domain: mesh.Mesh, facets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Unit outward normals and centres of exterior facets (reference configuration)."""
     gdim, tdim = domain.geometry.dim, domain.topology.dim
@@ -380,4 +430,5 @@ __all__ = [
     "check_obstacles_face_their_facets",
     "check_pair_surfaces",
     "warn_locking",
+    "warn_untagged_penetration",
 ]
