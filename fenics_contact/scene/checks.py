@@ -192,6 +192,8 @@ def warn_locking(scene: Scene, nu: float, where: str) -> None:
 def warn_untagged_penetration(scene: Scene, problem: ContactProblem) -> int:
     """Warn where boundary nodes outside an obstacle's candidate facets lie inside it.
 
+    Over the bodies whose facets the obstacle may touch (a plane is infinite,
+    a finite plate pressing one body is not: the others are not checked).
     Only the tagged facets are held by an obstacle; a face left out of the
     tag (a side that folds over under large compression, a corner that
     rolls) passes through it unnoticed, and the answer is wrong without a
@@ -205,15 +207,29 @@ def warn_untagged_penetration(scene: Scene, problem: ContactProblem) -> int:
     domain, V, u = problem.domain, problem.V, problem.u
     tdim, gdim = domain.topology.dim, domain.geometry.dim
     domain.topology.create_connectivity(tdim - 1, tdim)
+    f2c = domain.topology.connectivity(tdim - 1, tdim)
     boundary = mesh.exterior_facet_indices(domain.topology)
     owned = V.dofmap.index_map.size_local
     X = V.tabulate_dof_coordinates()[:, :gdim]
     x = X + u.x.array.reshape(-1, gdim)
-    on_boundary = fem.locate_dofs_topological(V, tdim - 1, boundary)
+    tags = problem.solid.cell_tags
+    cell_tag = np.zeros(domain.topology.index_map(tdim).size_local
+                        + domain.topology.index_map(tdim).num_ghosts, np.int64)
+    if tags is not None:
+        cell_tag[tags.indices] = tags.values
+
+    def body_of(facets: np.ndarray) -> np.ndarray:
+        return cell_tag[np.array([f2c.links(f)[0] for f in facets], np.int64)] \
+            if facets.size else np.zeros(0, np.int64)
+
     total = 0
     for contact in problem.contacts:
         if not isinstance(contact, ObstacleContact):
             continue
+        # the bodies the obstacle presses (a plane is infinite; a finite plate is not)
+        pressed = np.unique(np.concatenate(problem.comm.allgather(body_of(contact.facets))))
+        mine = boundary[np.isin(body_of(boundary), pressed)]
+        on_boundary = fem.locate_dofs_topological(V, tdim - 1, mine)
         tagged = fem.locate_dofs_topological(V, tdim - 1, contact.facets)
         others = np.setdiff1d(on_boundary, tagged)
         others = others[others < owned]
