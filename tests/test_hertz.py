@@ -24,9 +24,11 @@ from mpi4py import MPI
 import fenics_contact  # noqa: F401  (before dolfinx)
 from benchmarks import cases
 from fenics_contact.references.hertz import (
+    diametral_approach,
     fit_contact_profile,
     half_width,
     hertz_line_contact,
+    load_for_diametral_approach,
     load_for_half_width,
     peak_pressure,
     plane_strain_modulus,
@@ -72,6 +74,19 @@ def test_formula_relations() -> None:
     assert pressure_profile([0.0, a, 2 * a, -3 * a], p0, a) == pytest.approx([p0, 0, 0, 0])
     with pytest.raises(ValueError, match="P must be"):
         half_width(-1.0, R, E, nu)
+
+
+def test_diametral_approach_and_its_inverse() -> None:
+    """The log law of a disc between plates, its inverse, and a clear refusal past a = R."""
+    P = 0.03
+    delta = diametral_approach(P, 1.0, 6.0, 0.3)
+    a = half_width(P, 1.0, 6.0, 0.3)
+    assert delta == pytest.approx(2 * P / (np.pi * 6.0 / 0.91) * (2 * np.log(4 / a) - 1))
+    assert load_for_diametral_approach(delta, 1.0, 6.0, 0.3) == pytest.approx(P, rel=1e-12)
+    # the contact stiffens as it widens: twice the load, less than twice the approach
+    assert diametral_approach(2 * P, 1.0, 6.0, 0.3) < 2 * delta
+    with pytest.raises(ValueError, match="small-strain"):
+        load_for_diametral_approach(5.0, 1.0, 6.0, 0.3)
 
 
 def test_fit_recovers_an_exact_ellipse() -> None:

@@ -47,20 +47,23 @@ def two_cylinders_figure(data: dict) -> Figure:
 
 
 def o_ring_table(data: dict) -> Rows:
-    """Per compression: force per length against Lindley, the contact width."""
-    header = ["compression c", "F/L", "Lindley", "F/L over Lindley", "contact width / d",
-              "Newton"]
-    rows = [[c, f, lin, ratio, width / 2.0, its] for c, f, lin, ratio, width, its in zip(
-        data["compression"], data["force_per_length"], data["lindley"], data["ratio"],
-        data["contact_width"], data["iterations"], strict=True)]
+    """Per compression: force per length against small-strain elasticity and Lindley, width."""
+    header = ["compression c", "F/L", "small-strain elasticity", "F/L over it", "Lindley",
+              "F/L over Lindley", "contact width / d", "Newton"]
+    rows = [[c, f, el, f / el, lin, ratio, width / 2.0, its]
+            for c, f, el, lin, ratio, width, its in zip(
+                data["compression"], data["force_per_length"], data["elastic"],
+                data["lindley"], data["ratio"], data["contact_width"], data["iterations"],
+                strict=True)]
     return header, rows
 
 
 def o_ring_figure(data: dict) -> Figure:
-    """Force per length against compression, FE and Lindley; the contact width."""
+    """Force per length against compression: FE, small-strain elasticity, Lindley; width."""
     fig, (left, right) = plt.subplots(1, 2, figsize=(10, 3.6))
     c = np.asarray(data["compression"])
     left.plot(c, data["force_per_length"], "o-", label="FE (plane strain, neo-Hookean)")
+    left.plot(c, data["elastic"], "k:", label="small-strain elasticity (disc between plates)")
     left.plot(c, data["lindley"], "k--", label="Lindley (empirical)")
     left.set_xlabel("compression c")
     left.set_ylabel("force per unit length F/L")

@@ -13,6 +13,8 @@ The pressures here are magnitudes (>= 0); the contact problem's multiplier
 is their negative. Any consistent unit system works (e.g. E in stress units,
 R in length units, P in stress * length).
 
+:func:`diametral_approach` gives the approach of two plates squeezing a
+whole cylinder (the log law of a disc under two Hertz loads), and
 :func:`fit_contact_profile` measures a and p0 on a mesh from nodal pressures.
 """
 
@@ -64,6 +66,42 @@ def load_for_half_width(a: float, R: float, E: float, nu: float) -> float:
     """The load per unit length P = pi E* a^2 / (4 R) that gives half-width ``a``."""
     _check_positive(a=a, R=R)
     return float(np.pi * plane_strain_modulus(E, nu) * a**2 / (4.0 * R))
+
+
+def diametral_approach(P: float, R: float, E: float, nu: float) -> float:
+    """Approach of two rigid, frictionless plates squeezing a cylinder (length units).
+
+    The plane-strain small-strain result for a full cylinder of radius R
+    loaded by Hertz pressures at both ends of a diameter (Johnson, Contact
+    Mechanics, 1985, chapter 5): delta = 2 P / (pi E*) (2 ln(4 R / a) - 1),
+    with a the Hertz half-width at load P per unit length (force / length).
+    delta is the shortening of the vertical diameter, 2 x each plate's
+    travel; it holds while a << R (a few per cent of compression).
+    """
+    a = half_width(P, R, E, nu)
+    return float(2.0 * P / (np.pi * plane_strain_modulus(E, nu)) * (2.0 * np.log(4.0 * R / a) - 1.0))
+
+
+def load_for_diametral_approach(delta: float, R: float, E: float, nu: float) -> float:
+    """The load per unit length P whose :func:`diametral_approach` is ``delta`` (force / length).
+
+    delta grows monotonically with P while a < 4 R / e (always, for a << R);
+    solved by bisection in log P to round-off.
+    """
+    _check_positive(delta=delta, R=R)
+    lo, hi = 1e-300, np.pi * plane_strain_modulus(E, nu) * R / 4.0  # a = R at hi
+    if delta >= diametral_approach(hi, R, E, nu):
+        raise ValueError(f"delta = {delta} is beyond the small-strain formula's range "
+                         f"(a would exceed R = {R}); use delta << R.")
+    for _ in range(2000):
+        mid = np.sqrt(lo * hi)
+        if diametral_approach(mid, R, E, nu) > delta:
+            hi = mid
+        else:
+            lo = mid
+        if hi / lo - 1.0 < 1e-15:
+            break
+    return float(np.sqrt(lo * hi))
 
 
 def pressure_profile(x: npt.ArrayLike, p0: float, a: float) -> np.ndarray:
