@@ -79,7 +79,8 @@ def diametral_approach(P: float, R: float, E: float, nu: float) -> float:
     travel; it holds while a << R (a few per cent of compression).
     """
     a = half_width(P, R, E, nu)
-    return float(2.0 * P / (np.pi * plane_strain_modulus(E, nu)) * (2.0 * np.log(4.0 * R / a) - 1.0))
+    compliance = 2.0 / (np.pi * plane_strain_modulus(E, nu))
+    return float(compliance * P * (2.0 * np.log(4.0 * R / a) - 1.0))
 
 
 def load_for_diametral_approach(delta: float, R: float, E: float, nu: float) -> float:
