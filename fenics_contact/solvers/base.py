@@ -7,6 +7,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Protocol
 
+import numpy as np
+
 from fenics_contact.model.problem import ContactProblem, VariationalSystem
 from fenics_contact.solvers.condensed import kernel_for
 from fenics_contact.solvers.diagnostics import (
@@ -74,14 +76,16 @@ def newton_loop(
 
     ``residual_norm`` assembles the residual the step needs and returns the
     norm used for the stopping test; ``after_step`` runs after each step
-    (the simultaneous Uzawa update). Returns the status and the step count.
+    (the simultaneous Uzawa update). Without it a step whose residual is not
+    finite is shortened (:func:`_shorten_to_finite`). Returns the status and
+    the step count.
     The monitor's tolerance bounds an inexact linear solve's forcing term
     (:meth:`NewtonKernel.newton_step`).
     """
     steps = 0
     kernel.begin_solve()
+    norm = residual_norm()
     while True:
-        norm = residual_norm()
         status = monitor.check(norm, state(), iterations=steps)
         if status is not None:
             return status, steps
@@ -90,6 +94,34 @@ def newton_loop(
         steps += 1
         if after_step is not None:
             after_step()
+            norm = residual_norm()
+        else:
+            norm = _shorten_to_finite(kernel, residual_norm)
+
+
+#: Halvings of a Newton step whose residual is not finite (an element turned inside out).
+SHORTENINGS = 6
+
+
+def _shorten_to_finite(kernel: NewtonKernel, residual_norm: Callable[[], float]) -> float:
+    """The residual after the last Newton step, halving the step while it is not finite.
+
+    A full step that turns an element inside out (J <= 0: the neo-Hookean
+    energy's log J is NaN) is taken back by halves, up to
+    :data:`SHORTENINGS` times (1/64 of the step), from the same direction;
+    the step lengths are the unknowns' own, so nothing else changes. An
+    iterate still not finite after that is returned as it is (the monitor
+    fails it).
+    """
+    norm = residual_norm()
+    length = 1.0
+    for _ in range(SHORTENINGS):
+        if np.isfinite(norm):
+            break
+        length /= 2.0
+        kernel.take_back(length)  # x0 - 2 length dx  ->  x0 - length dx
+        norm = residual_norm()
+    return norm
 
 
 #: Failures after which a frictional solve is retried with r_t halved: the
@@ -218,9 +250,10 @@ class NewtonStrategy:
     def _solve(self) -> SolveResult:
         monitor = self.monitor()
         before = self.kernel.linear_solves
+        own_update = type(self).after_step is not NewtonStrategy.after_step
         status, steps = newton_loop(
             self.kernel, monitor, self.residual_norm, self.problem.active_signature,
-            after_step=self.after_step,
+            after_step=self.after_step if own_update else None,
         )
         updates = steps if self.updates_each_step else 0
         return SolveResult(

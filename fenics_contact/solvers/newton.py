@@ -223,6 +223,11 @@ class NewtonKernel:
         self._push()
         return True
 
+    def take_back(self, fraction: float) -> None:
+        """x <- x + fraction dx: take back that fraction of the last Newton step."""
+        self.x.axpy(fraction, self.dx)
+        self._push()
+
     def _linear_solve(self) -> bool:
         """Set up the solver (keeping the hierarchy if the lag allows) and solve into dx.
 

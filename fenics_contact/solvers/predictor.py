@@ -105,6 +105,9 @@ class Extrapolated:
     def predict(self) -> bool:
         """Overwrite the fields with the extrapolated guess; False when there is none.
 
+        A guess that turns an element inside out (det F <= 0 somewhere) is not
+        used: the solve starts from the last converged state.
+
         Collective: every rank predicts, or none does.
         """
         comm = self.problem.comm
@@ -118,6 +121,12 @@ class Extrapolated:
         u, _ = self._state()
         u[:] = u1 + s * (u1 - u0)
         self._set_multipliers(lam1 + s * (lam1 - lam0))
+        if self.problem.min_det_F().value <= 0.0:
+            # the extrapolation turns an element inside out (a fold closing): start from
+            # the last converged state instead, whose elements are all admissible
+            u[:] = u1
+            self._set_multipliers(lam1)
+            return False
         return True
 
     def solve(self) -> SolveResult:
