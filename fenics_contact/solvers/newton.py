@@ -224,7 +224,7 @@ class NewtonKernel:
         return True
 
     def take_back(self, fraction: float) -> None:
-        """x <- x + fraction dx: take back that fraction of the last Newton step."""
+        """Take back that fraction of the last Newton step: x <- x + fraction dx."""
         self.x.axpy(fraction, self.dx)
         self._push()
 
