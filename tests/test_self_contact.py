@@ -93,6 +93,37 @@ def test_a_node_that_loses_every_facet_is_not_held_by_its_previous_one():
     assert proj.distance[0] == np.inf
 
 
+def test_a_node_an_iterate_pushed_through_its_facet_stays_paired():
+    """Behind its facet by more than the search depth: kept when it had that facet.
+
+    One Newton iterate of a closing wall (24 layers, facets of 0.0045) took
+    nodes through the opposite wall by several facet sizes; without a
+    partner they were lifted and open, and the walls passed through each
+    other (280 of 325 nodes lost their partner in the tube's closing step).
+    A node keeps the facet it had down to ``KEPT_DEPTH`` facet sizes; a new
+    facet still needs ``DEPTH``, and nothing is kept deeper than that (the
+    far side of a closed surface).
+    """
+    from fenics_contact.model.self_contact import DEPTH, KEPT_DEPTH
+
+    X = np.stack([np.linspace(1.0, -1.0, 21), np.zeros(21)], axis=1)  # normal +y
+    facets = np.stack([np.arange(20), np.arange(1, 21)], axis=1)
+    current = X[facets]
+    size = 0.1
+    excluded = neighbourhoods(X, facets, np.array([-1, -1, -1]), 3.0)
+    depths = np.array([0.5 * (DEPTH + KEPT_DEPTH), 0.5 * DEPTH, 1.2 * KEPT_DEPTH]) * size
+    points = np.stack([np.full(3, 0.05), -depths], axis=1)
+    normals = np.tile([0.0, -1.0], (3, 1))
+    below = facets.shape[0] // 2 - 1  # the facet over x = 0.05 (x runs from 1 to -1)
+    assert current[below, 1, 0] < 0.05 < current[below, 0, 0]
+    fresh = closest_facing(points, normals, current, excluded)
+    assert fresh.distance[0] == np.inf and fresh.distance[2] == np.inf
+    assert fresh.facet[1] == below and fresh.distance[1] == pytest.approx(depths[1])
+    kept = closest_facing(points, normals, current, excluded, previous=np.full(3, below))
+    assert kept.facet[0] == below and kept.distance[0] == pytest.approx(depths[0])
+    assert kept.distance[2] == np.inf
+
+
 def test_the_search_in_blocks_of_points_is_the_search_at_once(monkeypatch):
     """Memory is bounded by comparing blocks of points with every facet: same answer."""
     import fenics_contact.model.self_contact as self_contact

@@ -14,7 +14,10 @@ wall: on a convex wall it lies behind their straight extension (a false
 penetration), on a concave one in front by the sagitta only (a false
 contact once the wall flattens). A facet also counts only while the node
 lies in front of its plane or behind it by less than ``depth`` facet sizes:
-the far side of a closed convex surface faces a node too, from inside;
+the far side of a closed convex surface faces a node too, from inside
+(the facet a node had at the last search counts down to ``kept_depth``
+facet sizes: a Newton iterate may push a node through the opposite wall
+deeper than ``depth``, and it must stay paired to be pushed back);
 and only while the node's projection falls on it or within half a facet
 of it (the straight extension of a facet far from the node is no surface). A
 node that no facet qualifies for keeps the non-excluded facet with the
@@ -41,6 +44,8 @@ from fenics_contact.model.search import KEEP, TIE_TOL, Projection, facet_normals
 NEIGHBOURHOOD = 3.0
 #: Search depth behind a facet's plane, in mean facet sizes.
 DEPTH = 1.0
+#: The same for the facet a node had at the last search (a node an iterate pushed through).
+KEPT_DEPTH = 10.0
 #: Largest overshoot of a projection past its facet (local coordinate) for the facet to count.
 OVER = 0.5
 #: Point-facet pairs the search compares at once (its memory: about 200 bytes a pair).
@@ -105,6 +110,7 @@ def closest_facing(
     previous: np.ndarray | None = None,
     keep: float = KEEP,
     depth: float = DEPTH,
+    kept_depth: float = KEPT_DEPTH,
 ) -> Projection:
     """Assign each point the closest facet that is outside its neighbourhood and faces it.
 
@@ -118,6 +124,10 @@ def closest_facing(
         depth: how far behind a facet's plane a point may lie and still be
             assigned to it, in mean facet sizes (a facet of a closed convex
             surface faces the points on its opposite side, from inside).
+        kept_depth: the same for the facet a point had at the last search (mean
+            facet sizes): one Newton iterate may take a point through the
+            surface by more than ``depth``, and it must stay paired to be
+            pushed back.
     """
     n = points.shape[0]
     gdim = current.shape[2]
@@ -128,7 +138,7 @@ def closest_facing(
     if n > rows:  # every point against every facet: in blocks of points, to bound the memory
         parts = [closest_facing(points[b], point_normals[b], current, excluded[b],
                                 None if previous is None or previous.size != n else previous[b],
-                                keep, depth)
+                                keep, depth, kept_depth)
                  for b in (slice(k, k + rows) for k in range(0, n, rows))]
         return Projection(*(np.concatenate([getattr(q, f) for q in parts])
                             for f in ("facet", "xi", "distance", "overshoot")))
@@ -163,8 +173,14 @@ def closest_facing(
         p = np.where(ok, prev, 0)
         length = np.linalg.norm(current[p, 1] - current[p, 0], axis=-1)
         close = dist[rows, p] <= chosen[2] + keep * length
-        ok &= valid[rows, p] & (over[rows, p] <= keep) & close
+        # a deeper search for the facet a point had: in front of it (or barely behind) at
+        # the last search and deeper now, the point has passed through it in one Newton
+        # iterate (a penetration to push back), not reached a far side of the surface
+        kept = (allowed & (facing | no_rule[:, None]) & (over <= OVER)
+                & (signed > -kept_depth * size))
+        ok &= kept[rows, p] & (over[rows, p] <= keep) & close
         facet = np.where(ok, p, facet)
+        lonely &= ~ok
         # a node no facet qualifies for stays without a partner (infinite distance: lifted)
         chosen = (facet, xi[rows, facet], np.where(lonely, np.inf, dist[rows, facet]),
                   over[rows, facet])
@@ -222,9 +238,11 @@ class SelfContactPair(DeformablePair):
         return super().gap(x_s) + self.lift[0]
 
     def _search(self, current: np.ndarray) -> Projection:
-        proj = closest_facing(self.striker_positions(), self._node_normals(), current,
-                              self.excluded, previous=self.assignment)
         lift = self.lift.x.array.reshape(-1, self.gdim)
+        previous = None if self.assignment is None else np.where(
+            lift[: self.assignment.size, 0] > 0.0, -1, self.assignment)  # lifted: no partner
+        proj = closest_facing(self.striker_positions(), self._node_normals(), current,
+                              self.excluded, previous=previous)
         lift[:, 0] = np.where(np.isfinite(proj.distance), 0.0, self._lift_length)
         return proj
 
