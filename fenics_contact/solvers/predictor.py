@@ -227,11 +227,24 @@ class ActiveSetPredicted(Extrapolated):
             c.lam.x.scatter_forward()
         return True
 
+    #: A contact's smallest gap at rest below this fraction of h counts as touching.
+    touching_gap = 1e-2
+
     def _touching(self) -> None:
-        """Nodes that touch at rest (g <= 1e-12 h, lam = 0) start in contact."""
+        """The nodes that touch at rest start in contact (lam = 0 there).
+
+        Touching: the contact's smallest nodal gap, where it is below
+        ``touching_gap`` h (g = 0 at a node-to-segment or obstacle node that
+        touches; a mortar pair's weighted gap is the gap's mean over the
+        node's support, 1e-3 h at the touching node of two cylinders), and
+        every node within 1e-12 h of it.
+        """
+        comm = self.problem.comm
         for c, g in zip(self._chosen(), self._nodal_gaps(), strict=True):
             lam = c.lam.x.array[:g.size]
-            touch = (g <= 1e-12 * c.surface.h) & (lam >= 0.0)
+            smallest = comm.allreduce(float(np.min(g, initial=np.inf)), op=MPI.MIN)
+            level = max(smallest, 0.0) if smallest <= self.touching_gap * c.surface.h else 0.0
+            touch = (g <= level + 1e-12 * c.surface.h) & (lam >= 0.0)
             r = float(c.r.value)
             lam[touch] = -r * g[touch] - self.margin * 1e-6 * r * c.surface.h
             c.lam.x.scatter_forward()
