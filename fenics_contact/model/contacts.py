@@ -229,10 +229,14 @@ class Contact:
         return state
 
     def active_pattern(self) -> bytes:
-        """This rank's active set (lam + r g < 0; with friction open/stick/slip) as bytes."""
+        """This rank's active set as bytes: lam + r g < 0, or with friction the node pattern.
+
+        The pattern (:meth:`~.friction_terms.CoulombFriction.node_pattern`) is
+        open/stick/slip and each slipping node's direction.
+        """
         self.refresh()
         if self.friction is not None:
-            return self.friction.node_states().tobytes()
+            return self.friction.node_pattern().tobytes()
         return np.packbits(self.surface.nodal(self._pressure_form) < 0.0).tobytes()
 
     def update_multiplier(self) -> None:

@@ -252,13 +252,31 @@ class CoulombFriction:
 
     def node_states(self) -> np.ndarray:
         """Per owned node: 0 open (p_n = 0), 1 stick (:func:`~.friction.sticks`), 2 slip."""
+        return self._states_and_trial()[0]
+
+    def node_pattern(self) -> np.ndarray:
+        """:meth:`node_states` with each slipping node's direction (int8, per owned node).
+
+        A slipping node adds 4 << k where component k of its trial traction
+        y = lam_t + r_t dg_t is positive: an iteration that flips slip
+        directions (a 2-cycle between two Coulomb projections) changes the
+        pattern although no node changes state.
+        """
+        state, y = self._states_and_trial()
+        code = state.copy()
+        slip = state == SLIP
+        for k in range(y.shape[1]):
+            code[slip] += np.int8(4 << k) * (y[slip, k] > 0.0).astype(np.int8)
+        return code
+
+    def _states_and_trial(self) -> tuple[np.ndarray, np.ndarray]:
         y = self._nodal_components(self._y_forms)
         pressure, rho = self._pressure_and_radius()
         stick = sticks(y, rho, float(self.eps.value))
         state = np.full(rho.size, OPEN, dtype=np.int8)
         active = pressure < 0.0
         state[active] = np.where(stick[active], STICK, SLIP)
-        return state
+        return state, y
 
     def tangential_fields(self) -> tuple[np.ndarray, np.ndarray]:
         """Owned nodal vectors in global axes, shape (n, gdim) each.
