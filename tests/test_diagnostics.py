@@ -38,6 +38,24 @@ def test_alternating_active_sets_without_progress_are_cycling():
     assert m.iterations < 12
 
 
+def test_a_two_cycle_within_one_active_set_is_cycling():
+    """The sliding blocks at mu = 10, first reversed step: residuals 0.161, 0.0628, 0.161, ...
+
+    with one active pattern throughout (every node in the same state and
+    slip direction); `auto` spent 100 iterations in each of two such
+    cycles (206 in the step) before they were found, 33 after.
+    """
+    settings = SolverSettings(cycle_window=6, max_iterations=100)
+    values = [0.0176] + [0.161243, 0.062768] * 10
+    m = ConvergenceMonitor(settings)
+    assert feed(m, values, ["x"] + ["A"] * 20) == Status.CYCLING
+    assert m.iterations < 12
+    # one pattern and a residual that keeps falling, however slowly: not cycling
+    steady = [0.9**k for k in range(40)]
+    limited = ConvergenceMonitor(SolverSettings(cycle_window=6, max_iterations=30))
+    assert feed(limited, steady, ["A"] * 40) == Status.MAX_ITERATIONS
+
+
 def test_slow_but_steady_progress_is_not_cycling():
     settings = SolverSettings(cycle_window=6, max_iterations=30)
     values = [0.9**k for k in range(40)]

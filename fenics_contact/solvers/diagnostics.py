@@ -164,6 +164,13 @@ class ConvergenceMonitor:
         return self.status
 
     def _cycling(self) -> bool:
+        """No progress over the window and a state that comes back after another.
+
+        The state is the active pattern, and also the pattern with the
+        residual (3 digits of its log): the iterates of a pure 2-cycle may
+        share one pattern (every node in the same state and slip direction)
+        and differ only in where they are, which the residual tells apart.
+        """
         w = self.settings.cycle_window
         if len(self.residuals) <= w + 1:
             return False
@@ -172,11 +179,18 @@ class ConvergenceMonitor:
         if min(window) < before:
             return False
         states = self.states[-w:]
-        for i in range(len(states) - 2):
-            for j in range(i + 2, len(states)):
-                if states[j] == states[i] and any(states[k] != states[i] for k in range(i + 1, j)):
-                    return True
-        return False
+        marked = [(state, round(math.log10(r + 1e-300), 3) if math.isfinite(r) else None)
+                  for state, r in zip(states, window, strict=True)]
+        return _returns(states) or _returns(marked)
+
+
+def _returns(states: Sequence[Hashable]) -> bool:
+    """Whether some state comes back after a different one."""
+    for i in range(len(states) - 2):
+        for j in range(i + 2, len(states)):
+            if states[j] == states[i] and any(states[k] != states[i] for k in range(i + 1, j)):
+                return True
+    return False
 
 
 def convergence_order(residuals: Sequence[float], floor: float = 0.0) -> float:
