@@ -239,8 +239,7 @@ class SelfContactPair(DeformablePair):
 
     def _search(self, current: np.ndarray) -> Projection:
         lift = self.lift.x.array.reshape(-1, self.gdim)
-        previous = None if self.assignment is None else np.where(
-            lift[: self.assignment.size, 0] > 0.0, -1, self.assignment)  # lifted: no partner
+        previous = np.where(lift[:, 0] > 0.0, -1, self.assignment)  # lifted: no partner
         proj = closest_facing(self.striker_positions(), self._node_normals(), current,
                               self.excluded, previous=previous)
         lift[:, 0] = np.where(np.isfinite(proj.distance), 0.0, self._lift_length)
