@@ -4,11 +4,11 @@
 # This demo illustrates how to:
 #
 # - declare two bodies and one contact pair in a scene
-#   (`scenes/two_cylinders.toml`: two identical linear-elastic half-cylinders,
+#   (`scenes/two_cylinders_node_to_segment.toml`: two identical linear-elastic half-cylinders,
 #   R = 1, E = 200, nu = 0.3, plane strain, meshed with non-matching arcs);
 # - solve it with GNRM, the target's unknowns condensed out of the contact
 #   terms, once with the node-to-segment pair and once with the mortar pair
-#   (`scenes/two_cylinders_mortar.toml`);
+#   (`scenes/two_cylinders.toml`, the shipped scene);
 # - compare both pressure profiles with Hertz for two identical cylinders.
 #
 # ## The pair
@@ -121,7 +121,7 @@ def scene_of(name: str):
 # %%
 R, E, NU = 1.0, 200.0, 0.3
 results = {}
-for name in ("two_cylinders.toml", "two_cylinders_mortar.toml"):
+for name in ("two_cylinders_node_to_segment.toml", "two_cylinders.toml"):
     scene = scene_of(name)
     kind = scene.pairs[0].discretisation
     problem = build_problem(scene)

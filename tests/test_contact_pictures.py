@@ -97,7 +97,7 @@ def test_render_in_3d_uses_the_same_contact_view(ball_friction):
 
 def test_two_bodies_are_seen_from_the_target_side(tmp_path):
     """Two hemispheres (coarse): the striker's cap is seen from below, where the target is."""
-    scene = _scene("two_hemispheres_3d", **{
+    scene = _scene("two_hemispheres_3d_node_to_segment", **{
         "mesh.parameters": {"h_contact": 0.06, "h_far": 0.4}, "solver.steps": 2})
     outcome = run_scene(scene, tmp_path, pictures=False, comm=MPI.COMM_SELF)
     assert outcome.path.status == "converged"

@@ -162,7 +162,7 @@ def test_mortar_tangent_finite_differences() -> None:
 
 # -- scenes -------------------------------------------------------------------------------------
 def _scene_text(edit) -> str:
-    text = (ROOT / "scenes" / "block_on_block.toml").read_text()
+    text = (ROOT / "scenes" / "block_on_block_node_to_segment.toml").read_text()
     return edit(text).replace("../meshes", str(ROOT / "meshes"))
 
 
@@ -186,7 +186,7 @@ def test_mortar_scene_runs_end_to_end(tmp_path) -> None:
     from fenics_contact.cli import main
 
     out = tmp_path / "run"
-    scene = ROOT / "scenes" / "block_on_block_mortar.toml"
+    scene = ROOT / "scenes" / "block_on_block.toml"
     assert main(["run", str(scene), "--out", str(out), "--quiet"]) == 0
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == "converged"
@@ -196,7 +196,7 @@ def test_mortar_scene_runs_end_to_end(tmp_path) -> None:
     assert abs(summary["steps"][-1]["contact_force"] + PATCH_PRESSURE) < 1e-10
     from fenics_contact.scene.schema import load_scene
 
-    assert load_scene(ROOT / "scenes" / "two_cylinders_mortar.toml").pairs[0].discretisation \
+    assert load_scene(ROOT / "scenes" / "two_cylinders.toml").pairs[0].discretisation \
         == "mortar"
 
 
@@ -260,7 +260,7 @@ def test_a_striker_pushed_through_the_target_in_one_step_is_refused_then_cut_bac
     from fenics_contact.runner import run_scene
     from fenics_contact.scene.schema import load_scene
 
-    shipped = Path(__file__).parents[1] / "scenes" / "block_on_block_mortar.toml"
+    shipped = Path(__file__).parents[1] / "scenes" / "block_on_block.toml"
     text = shipped.read_text().replace('"../meshes/', f'"{shipped.parents[1]}/meshes/')
     text = text.replace('value = ["free", -0.01]', 'value = ["free", -0.3]').replace(
         "steps = 2", "steps = 1")

@@ -181,7 +181,7 @@ def test_mortar_scene_takes_mu(tmp_path):
     from fenics_contact.scene.schema import load_scene
 
     root = Path(__file__).resolve().parents[1]
-    text = (root / "scenes" / "two_cylinders_mortar.toml").read_text()
+    text = (root / "scenes" / "two_cylinders.toml").read_text()
     path = tmp_path / "mortar_mu.toml"
     path.write_text(text.replace('discretisation = "mortar"', 'discretisation = "mortar"\nmu = 0.2')
                     .replace("../meshes", str(root / "meshes")))

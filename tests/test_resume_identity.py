@@ -12,7 +12,7 @@ from fenics_contact.runner import run_scene
 from fenics_contact.scene.schema import load_scene
 
 ROOT = Path(__file__).parent.parent
-BLOCKS = (ROOT / "scenes" / "block_on_block.toml").read_text().replace(
+BLOCKS = (ROOT / "scenes" / "block_on_block_node_to_segment.toml").read_text().replace(
     '"../meshes/block_on_block.geo"', f'"{ROOT / "meshes" / "block_on_block.geo"}"'
 ) + "\n[output]\npictures = false\n"
 
@@ -59,7 +59,7 @@ def test_resume_refuses_a_scene_that_changes_the_answer(finished, tmp_path, old,
 def test_resume_accepts_settings_that_do_not_change_the_answer(finished, tmp_path):
     _, out = finished
     text = BLOCKS.replace('method = "gnrm"', 'method = "gnrm"\natol = 1e-9\nmax_iterations = 80')
-    text = text.replace('name = "block-on-block"', 'name = "renamed"')
+    text = text.replace('name = "block-on-block-node-to-segment"', 'name = "renamed"')
     assert read_latest(out / "checkpoint", _identity_of(tmp_path, text))["step"] == 2
 
 

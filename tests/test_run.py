@@ -225,13 +225,13 @@ def test_penalty_penetration_is_given_in_facet_sizes_with_a_note(tmp_path, capsy
 
 def test_a_log_gets_one_line_per_load_step(tmp_path, capsys):
     """Without a terminal (a log file, CI) no progress bar: one line per finished step."""
-    scene = SCENES / "block_on_block_mortar.toml"
+    scene = SCENES / "block_on_block.toml"
     assert main(["run", str(scene), "--out", str(tmp_path / "out"), "--no-pictures"]) == 0
     err = capsys.readouterr().err.splitlines()
     assert err == [
-        "block-on-block-mortar: load step 1/2 converged, load factor 0.5, 2 Newton iterations, "
+        "block-on-block: load step 1/2 converged, load factor 0.5, 2 Newton iterations, "
         "contact force 1.0989",
-        "block-on-block-mortar: load step 2/2 converged, load factor 1, 0 Newton iterations, "
+        "block-on-block: load step 2/2 converged, load factor 1, 0 Newton iterations, "
         "contact force 2.1978",
     ]
 

@@ -124,8 +124,8 @@ def test_stability_two_body_friction_records_coulomb_ratio_and_reference(tmp_pat
 
 def test_study_beside_another_scene_with_relative_r_fills_the_table(tmp_path):
     """--relative --beside: each scene's rows at the r asked (relative to its own E/h)."""
-    code = main(["study", str(SCENES / "block_on_block.toml"), "--beside",
-                 str(SCENES / "block_on_block_mortar.toml"), "--methods", "gnrm", "--r", "0.1,10",
+    code = main(["study", str(SCENES / "block_on_block_node_to_segment.toml"), "--beside",
+                 str(SCENES / "block_on_block.toml"), "--methods", "gnrm", "--r", "0.1,10",
                  "--relative", "--out", str(tmp_path)])
     assert code == 0
     lines = (tmp_path / "table.md").read_text().splitlines()

@@ -145,7 +145,7 @@ def test_two_body_half_model_with_friction_converges(tmp_path):
     traction is not zero; it used to diverge in the second step.
     """
     root = Path(__file__).parent.parent
-    text = (root / "scenes" / "block_on_block.toml").read_text()
+    text = (root / "scenes" / "block_on_block_node_to_segment.toml").read_text()
     text = text.replace('"../meshes/block_on_block.geo"', f'"{root / "meshes/block_on_block.geo"}"')
     text = text.replace('target = "target_face"', 'target = "target_face"\nmu = 0.3', 1)
     text = text.replace("E = 200.0", "E = 1000.0", 1) + "\n[output]\npictures = false\n"

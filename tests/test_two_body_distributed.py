@@ -32,7 +32,7 @@ SERIAL_FORCE = 0.08028729628296515
 
 
 def _hemispheres():
-    scene = load_scene(ROOT / "scenes" / "two_hemispheres_3d.toml")
+    scene = load_scene(ROOT / "scenes" / "two_hemispheres_3d_node_to_segment.toml")
     mesh = dataclasses.replace(scene.mesh, parameters={
         **scene.mesh.parameters, "h_contact": 0.04, "h_far": 0.12})
     return cases.build(dataclasses.replace(scene, mesh=mesh), 1.0, comm=MPI.COMM_WORLD)

@@ -3,7 +3,7 @@
 Cases, 10 load steps each, GNRM, nodal contact, MUMPS:
 the 2D Hertz cylinder on the medium mesh (h = 0.008, 3814 displacement DOFs)
 and the fine mesh (h = 0.004), at atol 1e-8; the two identical cylinders of
-``scenes/two_cylinders.toml`` (node-to-segment pair, graded non-matching
+``scenes/two_cylinders_node_to_segment.toml`` (node-to-segment pair, graded non-matching
 meshes) and the paper's Example 2 (``scenes/paper_ex2.toml``) with their
 scenes' solver settings. Predictors: ``previous`` (the last converged
 state), ``extrapolate`` (linear extrapolation of the last two) and
@@ -63,7 +63,7 @@ def shipped(name: str):
 CASES = {
     "hertz-medium": hertz(0.008),
     "hertz-fine": hertz(0.004),
-    "two-cylinders": shipped("two_cylinders"),
+    "two-cylinders": shipped("two_cylinders_node_to_segment"),
     "paper-ex2": shipped("paper_ex2"),
 }
 

@@ -3,7 +3,7 @@
 Two identical bodies (node-to-segment pair, condensing kernel) against one
 body on a rigid plane with about the same number of displacement DOFs
 (standard kernel), both GNRM, linear elastic. 2D: two half-cylinders and one
-half-cylinder. 3D: two hemispheres (``scenes/two_hemispheres_3d.toml``) and
+half-cylinder. 3D: two hemispheres (``scenes/two_hemispheres_3d_node_to_segment.toml``) and
 one sphere octant (``benchmarks.cases.hertz_sphere``). Per Newton iteration:
 search (closest point + target coefficients), transfer (selection matrix,
 P^T R, P^T J P, Dirichlet elimination), and the whole kernel time.
@@ -43,7 +43,7 @@ from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.linear import LinearSolverSettings
 
 #: Two hemispheres (quarter model) pressed 0.02 together.
-HEMISPHERES = Path(__file__).resolve().parents[2] / "scenes" / "two_hemispheres_3d.toml"
+HEMISPHERES = Path(__file__).resolve().parents[2] / "scenes" / "two_hemispheres_3d_node_to_segment.toml"
 #: Newton stopping test of the 3D runs with the iterative solver (as the DOF ladder).
 NEWTON_ITERATIVE = SolverSettings(atol=1e-12, rtol=1e-10, max_iterations=30)
 #: The kernel accounts whose sum is the kernel time (seconds).

@@ -1,6 +1,6 @@
 """Two cylinders against Hertz: pressure profile picture and accuracy record.
 
-Runs scenes/two_cylinders.toml (two identical linear-elastic half-disks,
+Runs scenes/two_cylinders_node_to_segment.toml (two identical linear-elastic half-disks,
 R = 1, E = 200, nu = 0.3, non-matching meshes, GNRM, 10 steps) and compares
 the final nodal pressures with Hertz for two identical cylinders
 (1/R_eff = 2/R, 1/E* = 2 (1 - nu^2)/E) at the computed force. Also solves
@@ -45,7 +45,7 @@ def solve(scene, out: Path) -> dict:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--scene", type=Path, default=Path("scenes/two_cylinders.toml"))
+    parser.add_argument("--scene", type=Path, default=Path("scenes/two_cylinders_node_to_segment.toml"))
     parser.add_argument("--out", type=Path, default=Path("results/bench"))
     args = parser.parse_args()
     scene = load_scene(args.scene)

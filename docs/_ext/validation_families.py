@@ -229,7 +229,7 @@ FAMILIES: dict[str, Family] = {
     "two_cylinders": Family(
         "Two cylinders against Hertz (node-to-segment)", squeeze.two_cylinders_table,
         squeeze.two_cylinders_figure,
-        "The shipped scene `scenes/two_cylinders.toml` (node-to-segment pair, non-matching "
+        "The shipped scene `scenes/two_cylinders_node_to_segment.toml` (node-to-segment pair, non-matching "
         "meshes) against Hertz for two identical cylinders at the computed force; the same "
         "scene solved at r = 0.01 and 100 E/h gives the same force and pressures (last rows: "
         "the relative force difference), with more Newton iterations at the large r.",
