@@ -264,8 +264,10 @@ def _linear_bodies(E_upper: float = 200.0, E_lower: float = 200.0,
 
 
 def _pair(striker: str, target: str, mu: float | None = None,
-          tangential_r_max: float | None = 2.0) -> dict[str, Any]:
-    pair: dict[str, Any] = {"name": "pair", "striker": striker, "target": target}
+          tangential_r_max: float | None = 2.0,
+          discretisation: str = "node-to-segment") -> dict[str, Any]:
+    pair: dict[str, Any] = {"name": "pair", "striker": striker, "target": target,
+                            "discretisation": discretisation}
     if mu is not None:
         pair["mu"] = mu
         pair["tangential_r_max"] = 1e300 if tangential_r_max is None else tangential_r_max
@@ -285,11 +287,13 @@ def _block_rows(n_upper: int, n_lower: int, upper_width: float, height: float = 
 def two_cylinders(
     h_contact: float = 0.02, *, push: float = 0.02, steps: int = 3,
     stiffness_ratio: float = 1.0, h_far: float = 0.2, target_ratio: float = 1.37,
+    discretisation: str = "node-to-segment",
 ) -> Scene:
     """Two half-disks (R = 1) pushed together by ``push`` (``scenes/two_cylinders.toml``).
 
     Hertz for two cylinders; E_upper = 200 ``stiffness_ratio``, E_lower = 200;
-    the target's contact size is ``target_ratio`` h_contact (non-matching).
+    the target's contact size is ``target_ratio`` h_contact (non-matching);
+    the pair's ``discretisation`` as in a scene.
     """
     return _scene(f"two-cylinders-h{h_contact:g}", {
         "scene": {"dimension": 2, "description": "two cylinders pressed together"},
@@ -297,7 +301,7 @@ def two_cylinders(
                  "parameters": {"h_contact": h_contact, "h_far": h_far,
                                 "target_ratio": target_ratio}},
         "body": _linear_bodies(200.0 * stiffness_ratio),
-        "pair": [_pair("striker_arc", "target_arc")],
+        "pair": [_pair("striker_arc", "target_arc", discretisation=discretisation)],
         "dirichlet": [{"tag": "top", "value": [0.0, -push]},
                       {"tag": "bottom", "value": [0.0, 0.0]}],
         "solver": _solver(steps),
@@ -356,13 +360,15 @@ def sliding_blocks(
 
 def ironing(
     *, steps: int = 10, slide: float = 0.6, h_indenter: float = 0.08, h_block: float = 0.12,
-    mu: float | None = None,
+    mu: float | None = None, discretisation: str = "node-to-segment", block_strikes: bool = False,
 ) -> Scene:
     """Ironing (``scenes/ironing.toml``, coarse by default): a neo-Hookean indenter on a block.
 
     E = 1000 (indenter) and 100 (block); pressed 0.1 over the first 20 % of
-    the path, then slid ``slide``.
+    the path, then slid ``slide``. The indenter strikes unless ``block_strikes``
+    (as in ``scenes/ironing.toml``, a mortar pair).
     """
+    sides = ("target_face", "striker_arc") if block_strikes else ("striker_arc", "target_face")
     return _scene(f"ironing-{h_indenter:g}", {
         "scene": {"dimension": 2, "description": "an indenter pressed and slid on a block"},
         "mesh": {"file": str(MESHES / "ironing.geo"),
@@ -371,7 +377,7 @@ def ironing(
                   "nu": 0.3},
                  {"name": "block", "tag": "target", "law": "neo-hookean", "E": 100.0,
                   "nu": 0.3}],
-        "pair": [_pair("striker_arc", "target_face", mu)],
+        "pair": [_pair(*sides, mu, discretisation=discretisation)],
         "dirichlet": [{"tag": "bottom", "value": [0.0, 0.0]},
                       {"tag": "top", "path": [[0.0, 0.0, 0.0], [0.2, 0.0, -0.1],
                                               [1.0, slide, -0.1]]}],

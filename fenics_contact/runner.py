@@ -255,14 +255,7 @@ def run_scene(
     problem = build_problem(scene, comm)
     used = contact_settings(problem)
     _warn_loose_tolerance(scene, problem)
-    strategy = make_strategy(
-        scene.solver.method, problem, scene.solver,  # a SolverSettings with stepping keys
-        linear=LinearSolverSettings(
-            kind=scene.solver.linear_solver, forcing=scene.solver.forcing,
-            reuse_preconditioner=scene.solver.reuse_preconditioner,
-        ),
-        observer=on_residual, predictor=scene.solver.predictor,
-    )
+    strategy = scene_strategy(scene, problem, on_residual)
     saved = restore(out / "checkpoint", problem, marker) if marker is not None else None
     if isinstance(strategy, Extrapolated) and saved is not None and saved.history:
         strategy.history = saved.history
@@ -300,27 +293,44 @@ def run_scene(
         writer.close()
     summary = _write_summary(comm, out, scene, path, used)
     warn_untagged_penetration(scene, problem)
-    draw = scene.pictures if pictures is None else pictures
-    if draw:
-        from fenics_contact.output.pictures import deformed_contact_picture
-        from fenics_contact.output.plotting import step_residuals
-
-        deformed_contact_picture(
-            problem, out / "deformed.png",
-            title=f"{scene.name}: load factor {path.steps[-1].load_factor:g} ({path.status})",
-        )
-        if comm.rank == 0:
-            step_residuals(path.steps, out / "residuals.png", title=scene.name)
-        if scene.frictional:
-            from fenics_contact.output.friction_plot import friction_profile
-
-            friction_profile(
-                problem, out / "friction.png",  # type: ignore[arg-type]
-                title=f"{scene.name}: tangential traction, load factor "
-                f"{path.steps[-1].load_factor:g}",
-            )
+    if scene.pictures if pictures is None else pictures:
+        draw_pictures(scene, problem, path, out)
     return RunOutcome(problem, path, summary, out)
 
 
-__all__ = ["RUN_FILES", "RunOutcome", "SolveResult", "contact_settings", "earlier_run",
-           "run_scene"]
+def scene_strategy(scene: Scene, problem: ContactProblem,
+                   on_residual: Callable[[int, float], None] | None = None):
+    """The strategy of the scene's [solver] on ``problem`` (method, linear solver, predictor)."""
+    return make_strategy(
+        scene.solver.method, problem, scene.solver,  # a SolverSettings with stepping keys
+        linear=LinearSolverSettings(
+            kind=scene.solver.linear_solver, forcing=scene.solver.forcing,
+            reuse_preconditioner=scene.solver.reuse_preconditioner,
+        ),
+        observer=on_residual, predictor=scene.solver.predictor,
+    )
+
+
+def draw_pictures(scene: Scene, problem: ContactProblem, path: RunRecord, out: Path) -> None:
+    """OUT/deformed.png, residuals.png and, with friction, friction.png of the last step."""
+    from fenics_contact.output.pictures import deformed_contact_picture
+    from fenics_contact.output.plotting import step_residuals
+
+    last = path.steps[-1].load_factor if path.steps else problem.load_factor
+    deformed_contact_picture(
+        problem, out / "deformed.png",
+        title=f"{scene.name}: load factor {last:g} ({path.status})",
+    )
+    if problem.comm.rank == 0 and path.steps:
+        step_residuals(path.steps, out / "residuals.png", title=scene.name)
+    if scene.frictional:
+        from fenics_contact.output.friction_plot import friction_profile
+
+        friction_profile(
+            problem, out / "friction.png",  # type: ignore[arg-type]
+            title=f"{scene.name}: tangential traction, load factor {last:g}",
+        )
+
+
+__all__ = ["RUN_FILES", "RunOutcome", "SolveResult", "contact_settings", "draw_pictures",
+           "earlier_run", "run_scene", "scene_strategy"]

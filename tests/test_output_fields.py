@@ -24,7 +24,7 @@ PATCH_PRESSURE = -200.0 / (1 - 0.3**2) * 0.01
 
 
 def _matching_blocks(tmp_path: Path, extra: str = "") -> Path:
-    """block_on_block_node_to_segment.toml with 8 divisions on both sides: coincident interface vertices."""
+    """block_on_block_node_to_segment.toml, 8 divisions on both sides: coincident vertices."""
     text = (SCENES / "block_on_block_node_to_segment.toml").read_text()
     text = text.replace('"../meshes/block_on_block.geo"', f'"{MESHES / "block_on_block.geo"}"')
     text = text.replace("n_lower = 11", "n_lower = 8").replace("steps = 2", "steps = 1")

@@ -112,7 +112,8 @@ def test_active_set_predictor_first_step_of_two_cylinders() -> None:
     from fenics_contact.scene.build import build_problem
     from fenics_contact.scene.schema import load_scene
 
-    scene = load_scene(Path(__file__).parent.parent / "scenes" / "two_cylinders_node_to_segment.toml")
+    scene = load_scene(Path(__file__).parent.parent / "scenes"
+                       / "two_cylinders_node_to_segment.toml")
     runs = {}
     for predictor in ("extrapolate", "active-set"):
         problem = build_problem(scene)

@@ -519,7 +519,8 @@ def test_degenerate_cell_is_named_with_its_place(tmp_path, monkeypatch):
     assert mesh is not None and MPI is not None
 
 
-BLOCKS = (Path(__file__).parent.parent / "scenes" / "block_on_block_node_to_segment.toml").read_text()
+BLOCKS = (Path(__file__).parent.parent / "scenes"
+          / "block_on_block_node_to_segment.toml").read_text()
 
 
 def _blocks(tmp_path, text=BLOCKS, geo=None):

@@ -266,7 +266,8 @@ def test_two_body_scene_errors(tmp_path, edit, message: str) -> None:
 
     from fenics_contact.scene.schema import SceneError, load_scene
 
-    text = (Path(__file__).resolve().parents[1] / "scenes" / "two_cylinders_node_to_segment.toml").read_text()
+    scenes = Path(__file__).resolve().parents[1] / "scenes"
+    text = (scenes / "two_cylinders_node_to_segment.toml").read_text()
     path = tmp_path / "bad.toml"
     path.write_text(edit(text).replace("../meshes", str(Path(__file__).parents[1] / "meshes")))
     with pytest.raises(SceneError, match=__import__("re").escape(message)):
@@ -286,7 +287,8 @@ def test_two_hemispheres_hertz_coarse() -> None:
     from fenics_contact.references.hertz3d import hertz_point_contact
 
     # the shipped quarter model: flat faces pushed 0.02 closer, symmetric on x = 0, y = 0
-    scene = load_scene(Path(__file__).resolve().parents[1] / "scenes" / "two_hemispheres_3d_node_to_segment.toml")
+    scenes = Path(__file__).resolve().parents[1] / "scenes"
+    scene = load_scene(scenes / "two_hemispheres_3d_node_to_segment.toml")
     scene = dataclasses.replace(scene, mesh=dataclasses.replace(
         scene.mesh, parameters={**scene.mesh.parameters, "h_contact": 0.05}))
     assert scene.dirichlet[0].value == (None, None, -0.02)

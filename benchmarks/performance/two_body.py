@@ -43,7 +43,8 @@ from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.linear import LinearSolverSettings
 
 #: Two hemispheres (quarter model) pressed 0.02 together.
-HEMISPHERES = Path(__file__).resolve().parents[2] / "scenes" / "two_hemispheres_3d_node_to_segment.toml"
+HEMISPHERES = (Path(__file__).resolve().parents[2] / "scenes"
+               / "two_hemispheres_3d_node_to_segment.toml")
 #: Newton stopping test of the 3D runs with the iterative solver (as the DOF ladder).
 NEWTON_ITERATIVE = SolverSettings(atol=1e-12, rtol=1e-10, max_iterations=30)
 #: The kernel accounts whose sum is the kernel time (seconds).

@@ -10,7 +10,8 @@ extreme: r from 1e-8 to 1e12 E/h (bar and Hertz cylinder), E from 1e-3 to
 1e12 (displacement loading: forces scale with E), nu up to 0.4999, 1/10/100
 load steps, an initial penetration, a grazing start, no contact, full
 contact, a very coarse and a fine mesh; two deformable bodies (r, stiffness
-ratio, large sliding); the sliding block with Coulomb friction (``friction``:
+ratio, large sliding), node-to-segment and mortar (``mortar-r``, ``mortar-stiffness``,
+``mortar-sliding``); the sliding block with Coulomb friction (``friction``:
 mu from 0 to 10 and a load reversal; ``friction-r``: r from 1e-8 to 1e12 E/h
 with the default cap r_t = min(r, 2 E/L) and with r_t = r); the sliding
 blocks pair with friction (``two-body-friction``, ``two-body-friction-r``);
@@ -77,7 +78,26 @@ def full_grid() -> list[StabilityCase]:
         for e in (-3, 0, 3)
     ]
     cases += [StabilityCase("ironing-short", "two-body-sliding", ironing())]
-    return cases + friction_grid() + pair_friction_grid() + many_contacts_grid()
+    return (cases + mortar_grid() + friction_grid() + pair_friction_grid()
+            + many_contacts_grid())
+
+
+def mortar_grid() -> list[StabilityCase]:
+    """The two-body cases on mortar pairs: r, stiffness ratio, large sliding.
+
+    The same two cylinders (non-matching arcs, touching at one point at
+    t = 0: a grazing start) and the short ironing with the block striking,
+    as in scenes/ironing.toml.
+    """
+    cases = [StabilityCase(f"mortar-cyl-r1e{e}", "mortar-r",
+                           two_cylinders(discretisation="mortar"), 10.0**e)
+             for e in range(-8, 13, 4)]
+    cases += [StabilityCase(f"mortar-cyl-stiffness1e{e}", "mortar-stiffness",
+                            two_cylinders(stiffness_ratio=10.0**e, discretisation="mortar"))
+              for e in (-3, 3)]
+    cases += [StabilityCase("mortar-ironing-short", "mortar-sliding",
+                            ironing(discretisation="mortar", block_strikes=True))]
+    return cases
 
 
 def many_contacts_grid() -> list[StabilityCase]:

@@ -45,7 +45,8 @@ def solve(scene, out: Path) -> dict:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--scene", type=Path, default=Path("scenes/two_cylinders_node_to_segment.toml"))
+    parser.add_argument("--scene", type=Path,
+                        default=Path("scenes/two_cylinders_node_to_segment.toml"))
     parser.add_argument("--out", type=Path, default=Path("results/bench"))
     args = parser.parse_args()
     scene = load_scene(args.scene)

@@ -8,10 +8,10 @@ import warnings
 from collections.abc import Sequence
 
 import fenics_contact  # noqa: F401  (imports the DOLFINx wheel first)
-from fenics_contact.cli import mesh, render, run, stability, study, tradeoff
+from fenics_contact.cli import compile, mesh, render, run, stability, study, tradeoff
 
 #: Subcommand modules, in the order ``--help`` lists them.
-SUBCOMMANDS = (run, render, study, mesh, tradeoff, stability)
+SUBCOMMANDS = (run, render, study, mesh, tradeoff, stability, compile)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -68,7 +68,9 @@ def step_residuals(steps: Sequence, path: Path, title: str = "") -> None:
     fig, ax = plt.subplots(figsize=(5.5, 4))
     for step in steps:
         history = [v for solve in step.residuals for v in solve]
-        ax.semilogy(range(len(history)), history, "o-", ms=3, lw=1, label=f"step {step.step}")
+        iterations = [k for k, v in enumerate(history) if v > 0]  # 0 (exact) has no log
+        ax.semilogy(iterations, [history[k] for k in iterations], "o-", ms=3, lw=1,
+                    label=f"step {step.step}")
     ax.set_xlabel("Newton iteration")
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_ylabel("static residual (L2 norm)")

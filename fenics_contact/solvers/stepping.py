@@ -280,6 +280,7 @@ def solve_load_path(
     on_iteration: Callable[[StepRecord, SolveResult], None] | None = None,
     record: RunRecord | None = None,
     first_step: int = 1,
+    last_step: int | None = None,
 ) -> RunRecord:
     """Drive the load factor 0 -> 1 in ``n_steps`` increments with cut-back.
 
@@ -290,6 +291,8 @@ def solve_load_path(
     final status and wall time. A resumed path starts at ``first_step`` from
     the problem's current load factor and fields (those of step
     ``first_step - 1``); the record holds the steps solved here.
+    ``last_step`` ends the path after that step (a partial path: status
+    "partial" when it converged up to there).
     """
     if n_steps < 1:
         raise ValueError(f"The number of load steps must be >= 1, got {n_steps}.")
@@ -297,7 +300,8 @@ def solve_load_path(
     run = start_record(strategy) if record is None else record
     run_start = time.perf_counter()
     t = problem.load_factor
-    for k in range(first_step, n_steps + 1):
+    end = n_steps if last_step is None else min(last_step, n_steps)
+    for k in range(first_step, end + 1):
         target = k / n_steps
         if target <= t + 1e-14:
             continue  # reached before (a resumed path)
@@ -353,6 +357,6 @@ def solve_load_path(
             return run
         if on_step is not None:
             on_step(step)
-    run.status = Status.CONVERGED.value
+    run.status = Status.CONVERGED.value if end == n_steps else "partial"
     run.wall_s += time.perf_counter() - run_start
     return run
