@@ -37,6 +37,14 @@ def test_a_run_after_compile_compiles_nothing(tmp_path):
         run = _command(cache, "run", scene, "--out", str(tmp_path / Path(scene).stem), "--quiet")
         assert run.returncode == 0, run.stderr
         assert _cached(cache) == compiled, (scene, sorted(_cached(cache) - compiled))
+    # the forms hold the moduli as constants: other E and nu need no new compilation
+    text = (SCENES / "paper_ex2.toml").read_text().replace('"../meshes', f'"{SCENES.parent}/meshes')
+    assert "E = 210.0" in text and "nu = 0.3" in text
+    other = tmp_path / "paper_ex2_soft.toml"
+    other.write_text(text.replace("E = 210.0", "E = 21.0").replace("nu = 0.3", "nu = 0.35"))
+    run = _command(cache, "run", str(other), "--out", str(tmp_path / "soft"), "--quiet")
+    assert run.returncode == 0, run.stderr
+    assert _cached(cache) == compiled, sorted(_cached(cache) - compiled)
     # the check can fail: a scene that was not compiled adds its forms
     run = _command(cache, "run", str(SCENES / "hertz_cylinder.toml"), "--out",
                    str(tmp_path / "hertz"), "--quiet", "--no-pictures")

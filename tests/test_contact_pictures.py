@@ -313,3 +313,19 @@ def test_friction_profile_zooms_on_a_narrow_zone():
     assert lo < s[touching].min() and hi > s[touching].max() and hi - lo < 1.0
     assert contact_window(s, np.abs(s - 1.0) < 1.5) is None  # wide: the whole surface
     assert contact_window(s, np.zeros_like(s, dtype=bool)) is None
+
+
+def test_screen_axes_do_not_turn_with_round_off():
+    """A normal along z read with round-off in x or y gives the same screen axes.
+
+    The pressed face of a symmetric quarter model is seen along z; its normal
+    comes out as (+-1e-17, -+1e-17, 1) depending on the mesh partition. The
+    axes must not swap (a picture turned by a quarter on 2 processes).
+    """
+    from fenics_contact.output.contact_view import screen_axes
+
+    up_a, right_a = screen_axes(np.array([1e-17, -2e-17, 1.0]))
+    up_b, right_b = screen_axes(np.array([-3e-17, 1e-17, 1.0]))
+    np.testing.assert_allclose(up_a, up_b, atol=1e-12)
+    np.testing.assert_allclose(right_a, right_b, atol=1e-12)
+    assert abs(up_a[1]) > 0.999  # y, the first of the global axes least along n (z excluded)

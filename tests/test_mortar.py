@@ -271,3 +271,27 @@ def test_a_striker_pushed_through_the_target_in_one_step_is_refused_then_cut_bac
     step = outcome.path.steps[-1]
     assert step.cutbacks >= 1
     assert step.contact_force == pytest.approx(200.0 / (1 - 0.3**2) * 0.3, rel=1e-6)
+
+
+def test_stability_grid_mortar_case_at_huge_r() -> None:
+    """The mortar group of the stability grid: auto at r = 1e12 E/h meets GNRM at r = 1.
+
+    GNRM and penalty diverge there (docs/two_bodies.md, mortar groups);
+    auto must converge to the reference answer of GNRM at r = 1 E/h.
+    """
+    from benchmarks.robustness.stability_grid import full_grid
+    from fenics_contact.sweeps.stability import run_case, select
+
+    groups = {c.group for c in full_grid()}
+    assert {"mortar-r", "mortar-stiffness", "mortar-sliding"} <= groups
+    (reference_case,) = select(full_grid(), ["mortar-cyl-r1e0"])
+    reference = run_case(reference_case, "gnrm")
+    assert reference.status == "converged", reference.message
+    (case,) = select(full_grid(), ["mortar-cyl-r1e12"])
+    gnrm = run_case(case, "gnrm")
+    assert gnrm.status != "converged"  # the case is extreme: the plain strategy fails
+    record = run_case(case, "auto")
+    assert record.status == "converged", record.message
+    assert record.steps_completed == 3 and record.max_penetration < 1e-8
+    assert record.iterations <= 20  # measured 17
+    assert abs(record.contact_force - reference.contact_force) <= 1e-6 * reference.contact_force

@@ -188,6 +188,13 @@ class Solid:
         ]
         dx = ufl.Measure("dx", domain=domain, subdomain_data=cell_tags)
         self._dx = {}
+        #: Each body's Lame moduli (mu, lmbda) as constants: the compiled forms serve
+        #: any E and nu (one compilation per law and body layout, not per value).
+        self._moduli = {
+            b.tag: (fem.Constant(domain, default_scalar_type(b.material.mu)),
+                    fem.Constant(domain, default_scalar_type(b.material.lmbda)))
+            for b in self.bodies
+        }
         for b in self.bodies:
             psi = b.material.strain_energy(self.u)
             q = quadrature_degree or energy_quadrature_degree(psi, self.u, degree)
@@ -200,7 +207,8 @@ class Solid:
     # -- energy -------------------------------------------------------------------
     def strain_energy(self) -> ufl.Form:
         """Sum over the bodies of int psi_b dV (energy; per unit thickness in 2D)."""
-        terms = [b.material.strain_energy(self.u) * self._dx[b.tag] for b in self.bodies]
+        terms = [b.material.strain_energy(self.u, self._moduli[b.tag]) * self._dx[b.tag]
+                 for b in self.bodies]
         return sum(terms[1:], terms[0])
 
     def external_work(self, ds: ufl.Measure, ids: Sequence[tuple[int, ...]]) -> ufl.Form | None:
@@ -319,6 +327,14 @@ class Solid:
         """Each body's law and its cells (None: every cell)."""
         return [
             (b.material, None if b.tag is None else self.cell_tags.find(b.tag))
+            for b in self.bodies
+        ]
+
+    def stresses(self) -> list[tuple[ufl.core.expr.Expr, np.ndarray | None]]:
+        """Each body's Cauchy stress (3 x 3, UFL, with the moduli constants) and its cells."""
+        return [
+            (b.material.cauchy_stress(self.u, self._moduli[b.tag]),
+             None if b.tag is None else self.cell_tags.find(b.tag))
             for b in self.bodies
         ]
 

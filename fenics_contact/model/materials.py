@@ -13,6 +13,9 @@ from dataclasses import dataclass
 
 import ufl
 
+#: (mu, lmbda), the Lame moduli as numbers or UFL expressions (stress units).
+Moduli = tuple[float | ufl.core.expr.Expr, float | ufl.core.expr.Expr]
+
 
 def elastic_constants_problem(E: float, nu: float) -> tuple[str, str] | None:
     """Why (E, nu) are not valid isotropic constants: (name, what is wrong), or None.
@@ -75,25 +78,33 @@ class Elastic:
     #: Whether the law is geometrically nonlinear (finite strain).
     finite_strain: bool = True
 
-    def energy(self, H: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+    def energy(self, H: ufl.core.expr.Expr, moduli: Moduli | None = None) -> ufl.core.expr.Expr:
         """Stored energy density as a function of the displacement gradient H (d x d).
 
         With d = 2 the body is in plane strain (out-of-plane stretch one).
+        ``moduli``: (mu, lmbda) as UFL expressions (e.g. constants, so that the
+        compiled forms do not depend on their values); default the law's own.
         """
         raise NotImplementedError
 
-    def strain_energy(self, u: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
-        """Stored energy density psi(u) per unit reference volume."""
-        return self.energy(ufl.grad(u))
+    def moduli(self, moduli: Moduli | None = None) -> Moduli:
+        """(mu, lmbda): the ones given, else the law's own values."""
+        return (self.mu, self.lmbda) if moduli is None else moduli
 
-    def cauchy_stress(self, u: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+    def strain_energy(self, u: ufl.core.expr.Expr,
+                      moduli: Moduli | None = None) -> ufl.core.expr.Expr:
+        """Stored energy density psi(u) per unit reference volume."""
+        return self.energy(ufl.grad(u), moduli)
+
+    def cauchy_stress(self, u: ufl.core.expr.Expr,
+                      moduli: Moduli | None = None) -> ufl.core.expr.Expr:
         """Cauchy stress (3 x 3, out-of-plane component included in plane strain).
 
         Obtained as sigma = (1/J) P F^T with P = d psi / d H; the small-strain
         law returns P itself.
         """
         H = ufl.variable(_embed_3d(ufl.grad(u)))
-        P = ufl.diff(self.energy(H), H)
+        P = ufl.diff(self.energy(H, moduli), H)
         if not self.finite_strain:
             return P
         F = ufl.Identity(3) + H
@@ -117,12 +128,13 @@ def von_mises(sigma: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
 class SaintVenantKirchhoff(Elastic):
     """psi = lmbda/2 (tr E)^2 + mu E:E with the Green-Lagrange strain E (the paper's law)."""
 
-    def energy(self, H: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+    def energy(self, H: ufl.core.expr.Expr, moduli: Moduli | None = None) -> ufl.core.expr.Expr:
         """Stored energy density."""
+        mu, lmbda = self.moduli(moduli)
         d = H.ufl_shape[0]
         F = ufl.Identity(d) + H
         Egl = 0.5 * (F.T * F - ufl.Identity(d))
-        return 0.5 * self.lmbda * ufl.tr(Egl) ** 2 + self.mu * ufl.inner(Egl, Egl)
+        return 0.5 * lmbda * ufl.tr(Egl) ** 2 + mu * ufl.inner(Egl, Egl)
 
 
 @dataclass(frozen=True)
@@ -132,13 +144,14 @@ class NeoHookean(Elastic):
     In plane strain I1 = tr(C) + 1 (the out-of-plane stretch is one).
     """
 
-    def energy(self, H: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+    def energy(self, H: ufl.core.expr.Expr, moduli: Moduli | None = None) -> ufl.core.expr.Expr:
         """Stored energy density."""
+        mu, lmbda = self.moduli(moduli)
         d = H.ufl_shape[0]
         F = ufl.Identity(d) + H
         lnJ = ufl.ln(ufl.det(F))
         I1 = ufl.tr(F.T * F) + (3 - d)
-        return 0.5 * self.mu * (I1 - 3) - self.mu * lnJ + 0.5 * self.lmbda * lnJ**2
+        return 0.5 * mu * (I1 - 3) - mu * lnJ + 0.5 * lmbda * lnJ**2
 
 
 @dataclass(frozen=True)
@@ -151,10 +164,11 @@ class LinearElastic(Elastic):
 
     finite_strain: bool = False
 
-    def energy(self, H: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+    def energy(self, H: ufl.core.expr.Expr, moduli: Moduli | None = None) -> ufl.core.expr.Expr:
         """Stored energy density."""
+        mu, lmbda = self.moduli(moduli)
         eps = ufl.sym(H)
-        return 0.5 * self.lmbda * ufl.tr(eps) ** 2 + self.mu * ufl.inner(eps, eps)
+        return 0.5 * lmbda * ufl.tr(eps) ** 2 + mu * ufl.inner(eps, eps)
 
 
 MATERIALS: dict[str, type[Elastic]] = {

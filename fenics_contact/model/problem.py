@@ -381,6 +381,10 @@ class ContactProblem(FrictionalContacts):
         """Each body's law and its cells (None: every cell)."""
         return self.solid.laws()
 
+    def stresses(self) -> list[tuple[ufl.core.expr.Expr, np.ndarray | None]]:
+        """Each body's Cauchy stress (UFL) and its cells (None: every cell)."""
+        return self.solid.stresses()
+
     def body_ids(self) -> fem.Function | None:
         """Cell-wise body index for the output; None for a single body."""
         return self.solid.body_ids()

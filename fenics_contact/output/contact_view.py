@@ -163,7 +163,10 @@ def contact_normal(surface) -> np.ndarray | None:
 def screen_axes(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Screen (up, right) for a camera on +n: up the global axis z, y or x least along n."""
     candidates = np.eye(3)[[2, 1, 0]]
-    axis = candidates[int(np.argmin(np.abs(candidates @ normal)))]
+    along = np.abs(candidates @ normal)
+    # the first of the least (a tie within round-off keeps that order: the same
+    # picture from any partition of the mesh)
+    axis = candidates[int(np.flatnonzero(along <= along.min() + 1e-9)[0])]
     up = axis - (axis @ normal) * normal
     up /= np.linalg.norm(up)
     return up, np.cross(up, normal)

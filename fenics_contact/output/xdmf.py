@@ -180,9 +180,8 @@ class StepWriter:
         if "von_mises" in self.fields:
             self._stress = fem.Function(S, name="von_mises")
             self._stress_exprs = [
-                (fem.Expression(von_mises(law.cauchy_stress(problem.u)),
-                                S.element.interpolation_points), cells)
-                for law, cells in problem.laws()
+                (fem.Expression(von_mises(sigma), S.element.interpolation_points), cells)
+                for sigma, cells in problem.stresses()
             ]
 
     def _prepare(self, first_step: int) -> None:
