@@ -5,8 +5,10 @@
 #
 # - give a contact pair a Coulomb coefficient (`mu` in its `[[pair]]` block)
 #   and a load path that presses, then shears
-#   (`scenes/cattaneo_mindlin.toml`: two identical linear-elastic
-#   half-cylinders, R = 1, E = 200, nu = 0.3, mu = 0.3);
+#   (`scenes/cattaneo_mindlin_node_to_segment.toml`: two identical linear-elastic
+#   half-cylinders, R = 1, E = 200, nu = 0.3, mu = 0.3, on matching arcs and a
+#   node-to-segment pair; `scenes/cattaneo_mindlin.toml` is the same on
+#   non-matching arcs and a mortar pair, `--scene` runs it);
 # - read the stick and slip nodes of each load step;
 # - compare the stick zone and the tangential traction with
 #   Cattaneo-Mindlin's closed form (`fenics_contact.references.cattaneo`).
@@ -74,7 +76,8 @@ parser = argparse.ArgumentParser(description="Cattaneo-Mindlin partial slip")
 parser.add_argument("--out", type=Path, default=Path("results/cattaneo-mindlin"))
 parser.add_argument(
     "--scene", type=Path,
-    default=Path(__file__).resolve().parents[1] / "scenes" / "cattaneo_mindlin.toml",
+    default=(Path(__file__).resolve().parents[1] / "scenes"
+             / "cattaneo_mindlin_node_to_segment.toml"),
 )
 args, _ = parser.parse_known_args()  # tolerate notebook kernel arguments
 root = MPI.COMM_WORLD.rank == 0

@@ -4,7 +4,7 @@
 // Lower (target):  {x^2 + (y + R)^2 <= R^2, y >= -R}, flat face y = -R.
 // The bodies share no node: the lower one is meshed with a contact size
 // target_ratio * h_contact, so the meshes at the interface do not match.
-// Used by scenes/two_cylinders.toml, cattaneo_mindlin.toml and benchmarks/cases.py.
+// Used by scenes/two_cylinders*.toml, cattaneo_mindlin*.toml and benchmarks/cases.py.
 //
 // Physical groups:
 //   Surface "striker" = 1, Surface "target" = 2        (cell tags)

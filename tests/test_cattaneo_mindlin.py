@@ -1,6 +1,6 @@
 """Cattaneo-Mindlin with two identical cylinders (Dundurs beta = 0), on a coarse mesh.
 
-scenes/cattaneo_mindlin.toml with h = 0.006 at contact (33 nodes across
+scenes/cattaneo_mindlin_node_to_segment.toml with h = 0.006 at contact (33 nodes across
 2a, matching arcs) instead of 0.003, in 6 steps (2 pressing, 4 shifting)
 instead of 12: Q/(mu P) = 0.23, 0.45, 0.67, 0.87. The shipped mesh is
 measured in benchmarks/validation/cattaneo_mindlin.py.
@@ -17,7 +17,7 @@ from fenics_contact.cli import main
 from fenics_contact.references.cattaneo import two_cylinders_hertz
 from fenics_contact.scene.schema import load_scene
 
-SCENE = Path(__file__).parent.parent / "scenes" / "cattaneo_mindlin.toml"
+SCENE = Path(__file__).parent.parent / "scenes" / "cattaneo_mindlin_node_to_segment.toml"
 MU = 0.3
 
 

@@ -27,18 +27,19 @@ MU = 0.3
 STEPS = 10
 PRESS_STEPS = 4
 #: Serial reference (GNRM, r = 1 E/h): iterations, normal and tangential forces per step.
-SERIAL_ITERATIONS = [4, 2, 3, 3, 3, 5, 3, 3, 3, 3]
-SERIAL_NORMAL_FORCES = [0.40398595962802525, 0.808114614557743, 1.2123839070404865,
-                        1.6167910454119663, 1.609284960245067, 1.5913595422737776,
-                        1.587425576300544, 1.5837711557503131, 1.5803207591573745,
-                        1.5769266950438767]
-SERIAL_TANGENTIAL_FORCES = [0.0023380051934388207, 0.004662539049471908,
-                            0.0069780174023980086, 0.009288918642495803,
-                            0.24731727289434954, 0.4774041044737072, 0.47622382560232457,
-                            0.4751272002070165, 0.47409157047510586, 0.4730727058064693]
-#: Node states per step along x (0 open, 1 stick, 2 slip): the edges slip while pressing,
-#: all stick at the first shear step but the right edge, all slip from step 6 on.
-SERIAL_NODE_STATES = ["2111112"] * 3 + ["2111111", "1111112"] + ["2222222"] * 5
+SERIAL_ITERATIONS = [4, 2, 2, 2, 3, 4, 5, 3, 3, 3]
+SERIAL_NORMAL_FORCES = [0.40449367165469996, 0.8092422321018584, 1.2142408925987644,
+                        1.61948485334182, 1.6122957689678001, 1.59544787786957,
+                        1.5909993864080847, 1.5871927328137598, 1.583531528600672,
+                        1.579854410619976]
+SERIAL_TANGENTIAL_FORCES = [0.00241933947338749, 0.00483840045152276,
+                            0.007277902267140075, 0.009756872095820756,
+                            0.24722567277164048, 0.47611305157204936, 0.47727671548700146,
+                            0.47613577233506044, 0.4750389384792678, 0.4739377988663167]
+#: Node states per step along x (0 open, 1 stick, 2 slip): every node sticks while
+#: pressing, one slips at the first shear step, one sticks at the second, all slip from
+#: step 7 on.
+SERIAL_NODE_STATES = ["1111111"] * 4 + ["1111121", "1222222"] + ["2222222"] * 4
 
 
 def mortar_blocks(mu: float | None = MU, r: float = 1.0):
@@ -77,8 +78,8 @@ def test_mortar_sliding_blocks_obey_coulomb(gnrm_run):
     assert run.converged
     for step in run.steps:
         assert step.tangential_force <= MU * step.contact_force * (1 + 1e-10)
-    for step in run.steps[:PRESS_STEPS]:  # pressing: only the edge nodes slip (measured 2)
-        assert step.tangential_force < 0.02 * MU * step.contact_force
+    for step in run.steps[:PRESS_STEPS]:  # pressing: F_t / (mu N) measured 2.0 %, all stick
+        assert step.tangential_force < 0.025 * MU * step.contact_force
         assert step.stick_count >= step.active_count - 2
     for step, state in zip(run.steps, states, strict=True):  # no gross slip below mu N
         if state.tangential_magnitude < MU * step.contact_force * (1 - 1e-6):
@@ -89,9 +90,10 @@ def test_mortar_sliding_blocks_obey_coulomb(gnrm_run):
     final = run.steps[-1]
     assert final.slip_count == final.active_count > 0 and final.stick_count == 0
     state = states[-1]
-    # in each node's own frame; the resultant of the frames (tilted) 1.1e-5 lower
+    # in each node's own frame (the tangents of the target facet it projects on); the
+    # resultant of the frames, tilted with the dented lower face, is 3.9e-5 lower
     assert state.tangential_magnitude == pytest.approx(MU * state.contact_force, rel=1e-8)
-    assert final.tangential_force == pytest.approx(MU * final.contact_force, rel=3e-5)
+    assert final.tangential_force == pytest.approx(MU * final.contact_force, rel=1e-4)
     tau = _gathered(np.abs(state.tangential_traction[:, 0]))
     limit = _gathered(state.coulomb_limit)
     node_state = _gathered(state.node_state)
@@ -193,11 +195,13 @@ def test_mortar_cattaneo_mindlin_coarse_non_matching(tmp_path):
     """Cattaneo-Mindlin, mortar, non-matching arcs (ratio 1.37), coarse h = 0.006, 6 steps.
 
     Measured: Q/(mu P) = 0.23, 0.45, 0.67, 0.87; stick half-width errors
-    -2.1, -3.8, -2.3, -9.0 % of c (node spacing at the edge 3.4 ... 8.3 %);
-    traction L2 errors (the nodal force per tributary length of the multiplier field)
-    22, 11, 5.6, 3.3 % (the multipliers themselves: 46, 23, 9.5, 5.0 %). The
-    shipped mesh (h = 0.003, 12 steps; benchmarks/validation/cattaneo_mortar.py)
-    is within 4.4 % in c.
+    -2.1, +0.2, -2.2, -8.8 % of c (node spacing at the edge 3.4 ... 8.3 %);
+    traction L2 errors (the nodal force per tributary length of the multiplier
+    field) 12.4, 6.8, 4.4, 3.3 %. With the slip weighted over the segments
+    instead of measured at each node's projection: -2.1, -3.8, -2.3, -9.0 %
+    and 22, 11, 5.6, 3.3 % (the stick edge a node spacing inside; the
+    bounds below fail there). The shipped mesh (h = 0.003, 12 steps;
+    benchmarks/validation/cattaneo_mortar.py) is within 3.7 % in c.
     """
     from benchmarks.validation.cattaneo import solve_cattaneo_mindlin
     from benchmarks.validation.cattaneo_mortar import mortar_scene
@@ -209,5 +213,7 @@ def test_mortar_cattaneo_mindlin_coarse_non_matching(tmp_path):
     for zone in run.zones:
         assert zone.stick_nodes > 0 and zone.slip_nodes > 0
         assert abs(zone.c_error) < 0.1, zone
+    assert abs(run.zones[1].c_error) < 0.01  # within a quarter of the node spacing (4 %)
+    assert run.zones[0].traction_error < 0.15 and run.zones[1].traction_error < 0.08
     assert run.zones[-1].traction_error < 0.04
-    assert run.zones[-2].traction_error < 0.07
+    assert run.zones[-2].traction_error < 0.05

@@ -5,7 +5,7 @@ are the package's (:mod:`fenics_contact.references.cattaneo`); this module
 drives the solvers over the load paths. :class:`CattaneoCylinder` is the
 interim single-body check (a half-cylinder on a rigid plane, Dundurs beta
 small but not zero, with an optional P2 displacement that no scene
-expresses); ``scenes/cattaneo_mindlin.toml`` is the two-body case.
+expresses); ``scenes/cattaneo_mindlin_node_to_segment.toml`` is the two-body case.
 """
 
 from __future__ import annotations
@@ -142,7 +142,7 @@ def solve_cattaneo(
     return problem, zones, iterations
 
 
-# -- two identical cylinders (Dundurs beta = 0): scenes/cattaneo_mindlin.toml ---------------
+# -- two identical cylinders (Dundurs beta = 0): scenes/cattaneo_mindlin*.toml --------------
 @dataclass
 class CattaneoRun:
     """A solved two-body Cattaneo-Mindlin scene.

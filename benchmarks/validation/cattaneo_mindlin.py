@@ -1,6 +1,6 @@
 """Cattaneo-Mindlin with two identical cylinders: stick half-width and traction profile.
 
-Runs scenes/cattaneo_mindlin.toml (two linear-elastic half-cylinders, R = 1,
+Runs scenes/cattaneo_mindlin_node_to_segment.toml (two linear-elastic half-cylinders, R = 1,
 E = 200, nu = 0.3: Dundurs beta = 0; pressed by 0.03, then the upper face
 shifted by 0.014, mu = 0.3, GNRM) on three meshes: the shipped one (h =
 0.003, matching arcs), the same with non-matching arcs (target_ratio 1.37)
@@ -36,7 +36,7 @@ from benchmarks.validation.cattaneo_plot import traction_picture
 from fenics_contact.scene.schema import MeshSpec, load_scene
 
 ROOT = Path(__file__).resolve().parents[2]
-SCENE = ROOT / "scenes" / "cattaneo_mindlin.toml"
+SCENE = ROOT / "scenes" / "cattaneo_mindlin_node_to_segment.toml"
 #: (label, mesh parameters replacing the scene's)
 CASES = [
     ("shipped: h 0.003, matching arcs", {}),

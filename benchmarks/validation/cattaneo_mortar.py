@@ -1,6 +1,6 @@
 """Cattaneo-Mindlin with a mortar pair on non-matching arcs: stick half-width and traction.
 
-scenes/cattaneo_mindlin.toml with ``discretisation = "mortar"`` and
+scenes/cattaneo_mindlin_node_to_segment.toml with ``discretisation = "mortar"`` and
 ``target_ratio`` (1.37: non-matching arcs), h at contact and the number
 of steps as given (a third of them pressing); prints per shift step
 Q/(mu P), the relative error of the stick half-width c against
@@ -29,7 +29,8 @@ from benchmarks import harness
 from benchmarks.validation.cattaneo import solve_cattaneo_mindlin
 from fenics_contact.scene.schema import load_scene
 
-SCENE = Path(__file__).resolve().parents[2] / "scenes" / "cattaneo_mindlin.toml"
+SCENE = (Path(__file__).resolve().parents[2] / "scenes"
+         / "cattaneo_mindlin_node_to_segment.toml")
 
 
 def mortar_scene(directory: Path, h: float, ratio: float, steps: int) -> Path:

@@ -218,19 +218,17 @@ FAMILIES: dict[str, Family] = {
     "cattaneo_mortar": Family(
         "Cattaneo-Mindlin partial slip, mortar pair", sliding.cattaneo_mortar_table,
         sliding.cattaneo_mortar_figure,
-        "The shipped Cattaneo-Mindlin scene with a mortar pair on non-matching arcs. The "
-        "measured stick half-width is the midpoint between the last sticking and the first "
-        "slipping node: read its error against the half node spacing. In the recorded run "
-        "the half-width comes out below theory at every load ratio, at most of them by more "
-        "than the half node spacing (the node-to-segment page holds it within): the mortar "
-        "stick edge lies about a node spacing inside. The traction error is largest at "
-        "small Q, where the traction itself is small.",
+        "Cattaneo-Mindlin on non-matching arcs (h = 0.003, ratio 1.37) with a mortar pair, "
+        "the slip measured at each node's projection. The measured stick half-width is the "
+        "midpoint between the last sticking and the first slipping node: read its error "
+        "against the half node spacing. The traction error is largest at small Q, where "
+        "the traction itself is small; the shipped scene uses h = 0.002.",
     ),
     "two_cylinders": Family(
         "Two cylinders against Hertz (node-to-segment)", squeeze.two_cylinders_table,
         squeeze.two_cylinders_figure,
-        "The shipped scene `scenes/two_cylinders_node_to_segment.toml` (node-to-segment pair, non-matching "
-        "meshes) against Hertz for two identical cylinders at the computed force; the same "
+        "The scene `scenes/two_cylinders_node_to_segment.toml` (node-to-segment pair, "
+        "non-matching meshes) against Hertz for two identical cylinders at the computed force; the same "
         "scene solved at r = 0.01 and 100 E/h gives the same force and pressures (last rows: "
         "the relative force difference), with more Newton iterations at the large r.",
     ),

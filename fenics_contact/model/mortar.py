@@ -39,7 +39,6 @@ from mpi4py import MPI
 from fenics_contact.model.contact import ContactSettings, ContactSurface, assemble_local
 from fenics_contact.model.contacts import Contact
 from fenics_contact.model.friction import FrictionSettings
-from fenics_contact.model.mortar_friction import mortar_slip
 from fenics_contact.model.search import penetration_depth
 from fenics_contact.model.segments import (
     NEAR,
@@ -122,7 +121,6 @@ class MortarTransfer:
         self.search_count = 0
         self.overflow = 0
         self._searched_u: np.ndarray | None = None
-        self.w_prev: fem.Function | None = None
 
     def refresh(self) -> bool:
         """Search the slots and fill X, w and m; True when some slot changed (any rank)."""
@@ -151,8 +149,6 @@ class MortarTransfer:
                                            self.striker.X[self.me])
                 self._src[:, row] = np.where(on, self.target.vertices[vert], self.block)
         w = self._select(us, ut)
-        if self.w_prev is not None:
-            self.w_prev.x.array[:] = self._select(*self._prev).reshape(-1)
         self.X.x.array[:] = self._X.reshape(-1)
         self.w.x.array[:] = w.reshape(-1)
         self.m.x.array[:] = self._m.reshape(-1)
@@ -191,19 +187,6 @@ class MortarTransfer:
             for e in (0, 1):
                 w[:, 2 + 2 * k + e] = np.where(on, ut[fv[f, e]], us[self.me])
         return w
-
-    def track_previous(self, u_prev: fem.Function) -> fem.Function:
-        """The rows of u_prev selected like w (data, refilled by every search)."""
-        self._u_prev = u_prev
-        self.w_prev = fem.Function(self.W, name="mortar_w_prev")
-        self.set_previous()
-        return self.w_prev
-
-    def set_previous(self) -> None:
-        """Gather u_prev on both surfaces and refill w_prev (collective)."""
-        self._prev = (self.striker.displacements(self._u_prev),
-                      self.target.displacements(self._u_prev))
-        self.w_prev.x.array[:] = self._select(*self._prev).reshape(-1)
 
     def _scores(self, xs: np.ndarray, xt: np.ndarray) -> np.ndarray:
         """Overlaps of the target facets with each node's two striker facets, and near contact.
@@ -298,7 +281,8 @@ class MortarContact(Contact):
         settings: r, its scale; the quadrature must be 'nodal' (the vertex rule
             on the nodal pairs).
         slots: target facets a striker node may see (default from the facet sizes).
-        friction: Coulomb friction (None: frictionless); see :mod:`.mortar_friction`.
+        friction: Coulomb friction (None: frictionless); the slip is measured at each
+            striker node's projection on the target (:meth:`slip_increment`).
         name: label in outputs.
     """
 
@@ -334,20 +318,20 @@ class MortarContact(Contact):
 
             self.mortar = MortarTransfer3D(solid.V, solid.u, self.surface, self.target_facets,
                                            self.surface.h, self.lam)
-            self.mortar.refresh()
-            if self.friction_settings is not None:
-                # the slip of each striker node at its projection (node-to-segment)
-                from fenics_contact.model.pairs import DeformablePair
-
-                self.slip_pair = DeformablePair(solid.V, solid.u, self.surface,
-                                                self.target_facets)
-                self.slip_pair.refresh()
-                self._transfer = Transfers([self.mortar, self.slip_pair])
-            return self.mortar.G
-        self.mortar = MortarTransfer(solid.V, solid.u, self.surface, self.target_facets,
-                                     self._slots)
-        X = ufl.SpatialCoordinate(solid.domain)
+        else:
+            self.mortar = MortarTransfer(solid.V, solid.u, self.surface, self.target_facets,
+                                         self._slots)
         self.mortar.refresh()
+        if self.friction_settings is not None:
+            # the slip of each striker node at its projection on the target (module doc)
+            from fenics_contact.model.pairs import DeformablePair
+
+            self.slip_pair = DeformablePair(solid.V, solid.u, self.surface, self.target_facets)
+            self.slip_pair.refresh()
+            self._transfer = Transfers([self.mortar, self.slip_pair])
+        if solid.gdim == 3:
+            return self.mortar.G
+        X = ufl.SpatialCoordinate(solid.domain)
         #: The gap of a node whose support meets no target facet (length; a Constant so
         #: that the compiled forms do not depend on the mesh).
         self.open_gap = fem.Constant(solid.domain, default_scalar_type(self.surface.h))
@@ -389,38 +373,34 @@ class MortarContact(Contact):
         return assemble_local(self._report_form) / self.surface.lumped_area
 
     def slip_increment(self, u_prev: fem.Function) -> tuple[ufl.core.expr.Expr, ufl.core.expr.Expr]:
-        """(T_j, s~_j) of the Coulomb terms.
+        """(T_j, s_j) of the Coulomb terms: the slip of each striker node at its projection.
 
-        2D: the weighted slip on the segments (:mod:`.mortar_friction`); 3D: the
-        slip of the striker node at its projection on the target (node-to-segment).
+        As for node-to-segment pairs (:func:`~.pairs.slip_at_projection`): the
+        increment of the striker node against the target point it projects on,
+        in the target facet's tangents. The normal part stays mortar's
+        (weighted gaps). Measured against the slip weighted over the segments
+        (docs/two_bodies.md, "Friction on mortar pairs"): the stick zone of
+        Cattaneo-Mindlin keeps its edge (the weighted slip smears it inwards by
+        about a node spacing) and the forms compile in a fraction of the time.
         """
-        if self.gdim == 3:
-            from fenics_contact.model.pairs import slip_at_projection
+        from fenics_contact.model.pairs import slip_at_projection
 
-            return slip_at_projection(self.slip_pair, self.solid.u, u_prev, self.gdim)
-        w_prev = self.mortar.track_previous(u_prev)
-        X = ufl.SpatialCoordinate(self.domain)
-        return mortar_slip(self.mortar, X, self.solid.u, u_prev, w_prev)
+        return slip_at_projection(self.slip_pair, self.solid.u, u_prev, self.gdim)
 
     def commit_frame(self) -> None:
-        """The previous frame <- the new u_prev (2D stencil rows; 3D the projections' vertices)."""
+        """The previous frame <- the new u_prev (the projections' target vertices)."""
         if self.friction is None:
             return
-        if self.gdim == 3:
-            self.slip_pair.set_previous()
-        else:
-            self.mortar.set_previous()
+        self.slip_pair.set_previous()
 
     def extras(self) -> list[fem.Function]:
         """The extras the kernel condenses.
 
         2D: the packed neighbour and slot displacements (w = S u); 3D: the nodal
-        gaps G and, with friction, the projections' target vertex displacements.
+        gaps G; with friction, then the projections' target vertex displacements.
         """
-        if self.gdim == 3:
-            slip = list(self.slip_pair.w) if self.friction_settings is not None else []
-            return [self.mortar.G, *slip]
-        return [self.mortar.w]
+        slip = list(self.slip_pair.w) if self.friction_settings is not None else []
+        return [self.mortar.G if self.gdim == 3 else self.mortar.w, *slip]
 
     @property
     def transfer(self):
@@ -453,11 +433,9 @@ class MortarContact(Contact):
         if self._target_force_forms is None:
             q = ufl.TestFunction(m.W)
             form = ufl.derivative(self.lagrangian(), m.w, q)
-            if self.friction is not None:
-                form += self.friction.work(self.friction.traction_t, m.w, q)
             self._target_force_forms = [fem.form(form, entity_maps=self.surface.entity_maps,
                                                  jit_options=self.jit_options)]
-        m.refresh()
+        self.refresh()
         from petsc4py import PETSc
 
         V = self.solid.V
@@ -475,6 +453,8 @@ class MortarContact(Contact):
         vec.assemblyEnd()
         out = fem.Function(V, name="target_contact_force")
         out.x.array[: im.size_local * 2] = -vec.getArray(readonly=True)
+        if self.friction is not None:
+            out.x.array[: im.size_local * 2] += self._friction_target_force()
         out.x.scatter_forward()
         vec.destroy()
         return out
@@ -500,7 +480,7 @@ class MortarContact(Contact):
         return out
 
     def _friction_target_force(self) -> np.ndarray:
-        """-S^T dW_t/dw of the projections' target vertices, owned V dofs (3D friction)."""
+        """-S^T dW_t/dw of the projections' target vertices, owned V dofs (friction)."""
         from petsc4py import PETSc
 
         pair = self.slip_pair
@@ -511,13 +491,14 @@ class MortarContact(Contact):
                          entity_maps=self.surface.entity_maps) for wk in pair.w]
         V = self.solid.V
         im = V.dofmap.index_map
-        vec = PETSc.Vec().createMPI((im.size_local * 3, im.size_global * 3), bsize=3,
+        d = self.gdim
+        vec = PETSc.Vec().createMPI((im.size_local * d, im.size_global * d), bsize=d,
                                     comm=self.comm)
         vec.set(0.0)
         for form, src in zip(self._friction_forms, pair.sources(), strict=True):
             local = fem.assemble_vector(form)
             local.scatter_reverse(la.InsertMode.add)
-            vec.setValuesBlocked(src.astype(PETSc.IntType), local.array[: pair.n_owned * 3],
+            vec.setValuesBlocked(src.astype(PETSc.IntType), local.array[: pair.n_owned * d],
                                  addv=PETSc.InsertMode.ADD)
         vec.assemblyBegin()
         vec.assemblyEnd()

@@ -11,7 +11,7 @@ tractions (Spence). :func:`solve_cattaneo` therefore presses frictionless
 (mu = 0 until the end of pressing, which is what beta = 0 would give) and
 switches mu on for the tangential phase; nu = 0.45 (beta = 0.091) keeps
 the Q-induced change of pressure small without locking. The half-cylinder of
-Hertz half-cylinder (``scenes/cattaneo_mindlin.toml``; small
+Hertz half-cylinder (``scenes/cattaneo_mindlin*.toml``; small
 strain, top face clamped) is pressed by moving the rigid plane up by
 ``push``, then loaded tangentially by moving it sideways by ``shift`` (Q <
 mu P). Cattaneo-Mindlin (2D):
