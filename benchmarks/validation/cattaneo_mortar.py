@@ -10,7 +10,7 @@ q(x) = mu p0 [sqrt(1 - x^2/a^2) - (c/a) sqrt(1 - x^2/c^2)].
 
 Writes OUT/cattaneo_mortar.json (one record per shift step) and .md.
 
-Run: ``python benchmarks/validation/cattaneo_mortar.py [--h 0.003] [--ratio 1.37] [--steps 12]
+Run: ``python benchmarks/validation/cattaneo_mortar.py [--h 0.002] [--ratio 1.37] [--steps 12]
 [--out results/bench]``.
 """
 
@@ -51,7 +51,7 @@ def mortar_scene(directory: Path, h: float, ratio: float, steps: int) -> Path:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--h", type=float, default=0.003)
+    parser.add_argument("--h", type=float, default=0.002)
     parser.add_argument("--ratio", type=float, default=1.37)
     parser.add_argument("--steps", type=int, default=12)
     parser.add_argument("--out", type=Path, default=harness.OUT)

@@ -218,11 +218,11 @@ FAMILIES: dict[str, Family] = {
     "cattaneo_mortar": Family(
         "Cattaneo-Mindlin partial slip, mortar pair", sliding.cattaneo_mortar_table,
         sliding.cattaneo_mortar_figure,
-        "Cattaneo-Mindlin on non-matching arcs (h = 0.003, ratio 1.37) with a mortar pair, "
-        "the slip measured at each node's projection. The measured stick half-width is the "
-        "midpoint between the last sticking and the first slipping node: read its error "
-        "against the half node spacing. The traction error is largest at small Q, where "
-        "the traction itself is small; the shipped scene uses h = 0.002.",
+        "The shipped Cattaneo-Mindlin scene: non-matching arcs (h = 0.002, ratio 1.37), a "
+        "mortar pair, the slip measured at each node's projection. The measured stick "
+        "half-width is the midpoint between the last sticking and the first slipping node: "
+        "read its error against the half node spacing. The traction error is largest at "
+        "small Q, where the traction itself is small.",
     ),
     "two_cylinders": Family(
         "Two cylinders against Hertz (node-to-segment)", squeeze.two_cylinders_table,
