@@ -323,7 +323,7 @@ class MortarContact(Contact):
                                          self._slots)
         self.mortar.refresh()
         if self.friction_settings is not None:
-            # the slip of each striker node at its projection on the target (module doc)
+            # the slip of each striker node at its projection on the target (slip_increment)
             from fenics_contact.model.pairs import DeformablePair
 
             self.slip_pair = DeformablePair(solid.V, solid.u, self.surface, self.target_facets)
