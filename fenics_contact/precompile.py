@@ -4,12 +4,12 @@ The first run of a scene on a machine compiles its UFL forms (FFCx, then a
 C compiler) and keeps them in the form cache (``$XDG_CACHE_HOME/fenics``,
 by default ``~/.cache/fenics``); later runs load them. The compilation is
 what a user waits for on a fresh machine: seconds for a rigid obstacle, half
-a minute for a 2D mortar pair, minutes for 2D mortar friction
+a minute for a 2D mortar pair, about a minute with friction
 (docs/benchmarks.md, "Time to the first Newton iteration").
 :func:`precompile` builds the scene as ``fenics-contact run`` does and
 solves its first load step into a temporary folder, writing that step's
-fields, so that every form a run needs up to its first written step is
-compiled; the run's output is then thrown away. Forms that only a later
+fields and drawing the run's pictures, so that every form a run needs up to
+its first written step is compiled; the output is then thrown away. Forms that only a later
 event asks for (``auto`` falling back to another strategy, a second
 strategy in a sweep) are compiled when they are first used.
 """
