@@ -23,7 +23,7 @@ ENV PIP_BREAK_SYSTEM_PACKAGES=1 \
 RUN python3 -m pip install --no-cache-dir -e ".[mesh,viz,test]"
 
 # Compile the shipped scenes' forms into the image's form cache (~/.cache/fenics),
-# so that their first run in a container starts at once (about 7 minutes for all
+# so that their first run in a container starts at once (6 minutes for all
 # of them on 2 cores). `docker build --build-arg COMPILE_SCENES=0` skips it.
 ARG COMPILE_SCENES=1
 RUN if [ "$COMPILE_SCENES" = "1" ]; then fenics-contact compile scenes/*.toml; fi
