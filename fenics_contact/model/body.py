@@ -323,13 +323,6 @@ class Solid:
             out[i] = vec.array[dofs].sum()
         return self.comm.allreduce(out, op=MPI.SUM)
 
-    def laws(self) -> list[tuple[Elastic, np.ndarray | None]]:
-        """Each body's law and its cells (None: every cell)."""
-        return [
-            (b.material, None if b.tag is None else self.cell_tags.find(b.tag))
-            for b in self.bodies
-        ]
-
     def stresses(self) -> list[tuple[ufl.core.expr.Expr, np.ndarray | None]]:
         """Each body's Cauchy stress (3 x 3, UFL, with the moduli constants) and its cells."""
         return [

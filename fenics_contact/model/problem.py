@@ -377,10 +377,6 @@ class ContactProblem(FrictionalContacts):
         """Reference coordinates of the owned multiplier nodes of every contact, shape (n, 3)."""
         return np.concatenate([c.nodal_coordinates() for c in self.contacts])
 
-    def laws(self) -> list[tuple[Elastic, np.ndarray | None]]:
-        """Each body's law and its cells (None: every cell)."""
-        return self.solid.laws()
-
     def stresses(self) -> list[tuple[ufl.core.expr.Expr, np.ndarray | None]]:
         """Each body's Cauchy stress (UFL) and its cells (None: every cell)."""
         return self.solid.stresses()
