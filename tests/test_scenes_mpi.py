@@ -33,6 +33,15 @@ SERIAL = {
                          "top-on-middle": 0.253626215966294, "floor": 0.25361549536003536}),
 }
 
+#: Scenes whose first load step may take one Newton iteration more or fewer on 2
+#: processes. The three blocks start touching with lam = 0, so their contacts
+#: start open and the first iterations wander (residuals 0.033, 0.62, 0.85,
+#: 0.67) until the set settles; there round-off decides. The fifth residual,
+#: serially and on 2 processes, for three layouts of the condensed matrix's
+#: pattern: 0.026 and 0.099 (7 and 7 iterations), 0.11 and 0.056 (7 and 6,
+#: the shipped one), 0.022 and 0.18 (6 and 7). The forces agree to 1e-10.
+WANDERING_FIRST_STEP = {"three_blocks_3d": 1}
+
 
 def _run(name: str, edits, tmp_path):
     text = (ROOT / "scenes" / f"{name}.toml").read_text()
@@ -54,7 +63,8 @@ def test_scene_gives_the_serial_counts_and_forces(name: str, tmp_path) -> None:
     its = [s.iterations for s in outcome.path.steps]
     states = outcome.problem.contact_states()
     got = {k: s.contact_force for k, s in states.items()}
-    assert its == iterations
+    spread = WANDERING_FIRST_STEP.get(name, 0)
+    assert abs(its[0] - iterations[0]) <= spread and its[1:] == iterations[1:], its
     assert sorted(got) == sorted(forces)
     for k, f in forces.items():
         assert got[k] == pytest.approx(f, rel=1e-10, abs=1e-14), k

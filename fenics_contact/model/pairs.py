@@ -24,6 +24,7 @@ facet. The solver condenses the w_k onto u with the selection w_k = S_k u
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 import ufl
 from dolfinx import fem, la, mesh
 
@@ -36,6 +37,10 @@ from fenics_contact.model.friction import FrictionSettings, tangent_basis
 from fenics_contact.model.search import TIE_TOL, Projection, SurfaceSearch, penetration_depth
 from fenics_contact.model.segments import node_blocks
 from fenics_contact.model.target_surface import REACH_FACETS, TargetSurface
+
+#: A node farther than this many facet sizes in front of its facet, with lam >= 0,
+#: is open at any r: the solver's condensation leaves it out (DeformablePair.coupled).
+COUPLING_GAP = 1.0
 
 
 class DeformablePair:
@@ -122,6 +127,10 @@ class DeformablePair:
         self.w = [fem.Function(self.W, name=f"target_w{k}") for k in range(nv)]
         self.assignment = np.full(n_w, -1, np.int64)
         self.projection = None
+        #: lam at each W block (owned first), set by a frictionless contact; None: every
+        #: node is condensed (see :meth:`coupled`).
+        self.multiplier = None
+        self._coupled = np.ones(self.W.dofmap.index_map.size_local, bool)
         self.w_prev: list[fem.Function] | None = None
         #: Incremented whenever some striker node changes facet (on any rank).
         self.version = 0
@@ -254,7 +263,10 @@ class DeformablePair:
             self.X[k].x.array[:] = self.X_vertices[verts[:, k]].reshape(-1)
             self.w[k].x.array[:] = w_t[verts[:, k]].reshape(-1)
         self._fill_previous()
-        if changed:
+        coupled = self.coupled(w_t)
+        moved = self.comm.allreduce(not np.array_equal(coupled, self._coupled), op=MPI.LOR)
+        self._coupled = coupled
+        if changed or moved:
             self.version += 1
         return changed
 
@@ -310,6 +322,70 @@ class DeformablePair:
         """
         facet = self.assignment[: self.n_owned]
         return [self.target_blocks[facet, k] for k in range(self.gdim)]
+
+    # -- condensation ----------------------------------------------------------------
+    def gap_offset(self) -> np.ndarray | float:
+        """What the pair adds to the gap to the assigned facet's plane (length; none here)."""
+        return 0.0
+
+    def coupled(self, w_t: np.ndarray) -> np.ndarray:
+        """Owned nodes whose contact can act at the current state (bool).
+
+        ``w_t``: the kept target vertices' displacements.
+
+        A node with lam >= 0 and a gap above :data:`COUPLING_GAP` facet sizes
+        is open whatever r (lam + r g > 0): its residual and tangent do not
+        depend on the target, so the solver leaves its selection out. Every
+        node counts when the contact gave no :attr:`multiplier`.
+        """
+        n = self.n_owned
+        if self.multiplier is None or self.projection is None:
+            return np.ones(n, bool)
+        verts = self.facet_vertex[self.assignment[:n]]
+        x = (self.X_vertices + w_t)[verts]
+        normal = self._normals(x)
+        normal /= np.linalg.norm(normal, axis=1)[:, None]
+        points = self.striker_positions()[:n]
+        offset = np.asarray(self.gap_offset())
+        gap = np.einsum("ij,ij->i", points - x[:, 0], normal) + (
+            offset[:n] if offset.ndim else offset)
+        lam = self.multiplier()[:n]
+        return (gap < COUPLING_GAP * self._size) | (lam < 0.0)
+
+    def condensation(self) -> list[sp.csr_matrix]:
+        """w_k = S_k u as sparse rows (owned W dofs by global V dofs), open nodes left out."""
+        n, bs = self.n_owned, self.gdim
+        keep = np.repeat(self._coupled, bs)
+        rows = np.flatnonzero(keep)
+        out = []
+        for block in self.sources():
+            cols = (block[:, None] * bs + np.arange(bs)[None, :]).reshape(-1)[keep]
+            out.append(sp.csr_matrix((np.ones(rows.size), (rows, cols)),
+                                     shape=(n * bs, self.V.dofmap.index_map.size_global * bs)))
+        return out
+
+    def reachable_blocks(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """The V blocks each owned node may select once its facet moves to a neighbour.
+
+        For every selection of :meth:`sources`: (indptr, blocks), CSR rows of
+        owned nodes listing the vertices of the kept facets that share a
+        vertex with the node's assigned facet (none for a node without one).
+        The solver keeps these couplings in its pattern, so that moving to
+        such a facet changes values only.
+        """
+        fv = self.facet_vertex
+        m, nv = fv.shape
+        incidence = sp.csr_matrix(
+            (np.ones(fv.size), (np.repeat(np.arange(m), nv), fv.reshape(-1))),
+            shape=(m, self.vertices.size))
+        star = ((incidence @ incidence.T) @ incidence).tocsr()
+        facet = self.assignment[: self.n_owned]
+        rows = star[np.where(facet >= 0, facet, 0)]
+        rows = sp.diags(((facet >= 0) & self._coupled).astype(float)) @ rows
+        rows.eliminate_zeros()
+        rows.sort_indices()
+        near = (rows.indptr.astype(np.int64), self.vertices[rows.indices].astype(np.int64))
+        return [near] * self.gdim
 
 
 class NodeToSegmentContact(Contact):
@@ -378,8 +454,20 @@ class NodeToSegmentContact(Contact):
                                         self.facets, self.neighbourhood)
         else:
             self.pair = DeformablePair(solid.V, solid.u, self.surface, self.target_facets)
+        if not self.frictional:
+            self.pair.multiplier = self._multiplier_at_nodes
         self.pair.refresh()
         return self.pair.gap(ufl.SpatialCoordinate(solid.domain) + solid.u)
+
+    def _multiplier_at_nodes(self) -> np.ndarray:
+        """The multiplier at each W block of the pair (both live on the striker submesh)."""
+        if getattr(self, "_lam_of_w", None) is None:
+            W, Q = self.pair.W, self.lam.function_space
+            index = np.zeros(W.dofmap.index_map.size_local + W.dofmap.index_map.num_ghosts,
+                             np.int64)
+            index[W.dofmap.list.reshape(-1)] = Q.dofmap.list.reshape(-1)
+            self._lam_of_w = index
+        return self.lam.x.array[self._lam_of_w]
 
     # -- search ---------------------------------------------------------------------
     def refresh(self) -> bool:

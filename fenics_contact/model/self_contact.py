@@ -237,6 +237,10 @@ class SelfContactPair(DeformablePair):
         """The pair's gap plus the lift of the nodes with no partner (length, >= 0 open)."""
         return super().gap(x_s) + self.lift[0]
 
+    def gap_offset(self) -> np.ndarray:
+        """The lift of each node with no partner (length; 0 for the others)."""
+        return self.lift.x.array.reshape(-1, self.gdim)[:, 0]
+
     def _search(self, current: np.ndarray) -> Projection:
         lift = self.lift.x.array.reshape(-1, self.gdim)
         previous = np.where(lift[:, 0] > 0.0, -1, self.assignment)  # lifted: no partner

@@ -79,6 +79,17 @@ class Transfers:
             out += list(t.condensation() if hasattr(t, "condensation") else t.sources())
         return out
 
+    def reachable_blocks(self) -> list:
+        """Per extra, the V blocks each node may come to select, or None (see pairs)."""
+        out: list = []
+        for t in self.transfers:
+            if hasattr(t, "reachable_blocks"):
+                out += list(t.reachable_blocks())
+            else:
+                items = t.condensation() if hasattr(t, "condensation") else t.sources()
+                out += [None] * len(items)
+        return out
+
     def curvature(self, residual_of) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The second-derivative terms of the contacts whose extras are not linear in u."""
         parts = [t.curvature(residual_of) for t in self.transfers if hasattr(t, "curvature")]

@@ -9,8 +9,14 @@ them with P = [[I, 0], [0, I], [S_1, 0], ...]:
 
     R = P^T R_ext,    J = P^T J_ext P     (PETSc MatPtAP)
 
-The symbolic product is redone only when the search changes an assignment
-(``transfer.version``). Dirichlet rows and columns are set after the product
+P keeps the nonzero pattern of every assignment it has held (explicit
+zeros where an entry is not selected now), so that a change of assignment
+that returns to couplings seen before changes values only: the symbolic
+product, the matrix and the linear solver (a direct solver's analysis, a
+multigrid hierarchy's aggregates and prolongators) are kept. The symbolic
+product is redone only when an assignment reaches a column no earlier one
+had, or when the kept zeros outgrow the selection (:data:`KEPT_ZEROS`).
+Dirichlet rows and columns are set after the product
 (S couples target vertices that may carry prescribed values): rows hold
 x - x_D and the columns are eliminated with PETSc's ``zeroRowsColumns``,
 which also lifts the right-hand side. The residual norm is that of the
@@ -27,6 +33,7 @@ import ufl.algorithms
 from dolfinx import fem
 from dolfinx.fem import petsc as fem_petsc
 
+from mpi4py import MPI
 from petsc4py import PETSc
 
 from fenics_contact.model.problem import VariationalSystem
@@ -35,6 +42,10 @@ from fenics_contact.solvers.newton import NewtonKernel
 from fenics_contact.solvers.timing import stopwatch
 
 _prefix_counter = itertools.count()
+
+#: The pattern of P starts afresh when its kept zeros would outnumber the
+#: selected entries of the extras by more than this factor.
+KEPT_ZEROS = 2.0
 
 
 def _nonempty(form: ufl.Form | None) -> ufl.Form | None:
@@ -100,6 +111,7 @@ class CondensedKernel(NewtonKernel):
         self._bc_rows = (self._red0[comm.rank] + self._bc_local).astype(PETSc.IntType)
         self._g = np.zeros(self.unknowns[0].x.array.size)
         self.P: PETSc.Mat | None = None
+        self._P_keys: np.ndarray | None = None
         self.A: PETSc.Mat | None = None
         self._P_version = None
         self.linear = linear or LinearSolverSettings()
@@ -114,8 +126,11 @@ class CondensedKernel(NewtonKernel):
         owner = np.searchsorted(self._vranges, blocks, side="right") - 1
         return self._red0[owner] + (blocks - self._vranges[owner]) * self._bs
 
-    def _build_P(self) -> None:
+    def _build_P(self) -> bool:
         """P: extended rows to reduced columns; identity on unknowns, dw/du on extras.
+
+        Returns True when P is a new matrix (a new pattern), False when only its
+        values changed.
 
         An extra is either a 0/1 selection of V blocks (``sources()``) or, when
         the transfer has ``condensation()``, any sparse derivative of the extra
@@ -125,11 +140,16 @@ class CondensedKernel(NewtonKernel):
         counts = [np.ones(self._n_red, np.int64)]
         cols = [self._red0[rank] + np.arange(self._n_red, dtype=np.int64)]
         vals = [np.ones(self._n_red)]
-        for item in _condensation(self.transfer):
+        selections = {}  # item index -> (first extended row, number of rows)
+        offset = self._n_red
+        for i, item in enumerate(_condensation(self.transfer)):
             if isinstance(item, np.ndarray):
-                base = self._reduced_rows(np.asarray(item, np.int64).reshape(-1))
+                item = np.asarray(item, np.int64)
+                base = self._reduced_rows(item.reshape(-1))
                 # a 2D source (node, row) selects for a packed coefficient of shape (rows, bs)
                 col = (base[:, None] + np.arange(self._bs)[None, :]).reshape(-1)
+                selections[i] = (offset, col.size)
+                offset += col.size
                 counts.append(np.ones(col.size, np.int64))
                 cols.append(col)
                 vals.append(np.ones(col.size))
@@ -139,18 +159,73 @@ class CondensedKernel(NewtonKernel):
                 counts.append(np.diff(rows.indptr).astype(np.int64))
                 cols.append(self._reduced_dofs(rows.indices.astype(np.int64)))
                 vals.append(rows.data)
+                selections[i] = (offset, rows.shape[0])
+                offset += rows.shape[0]
         count = np.concatenate(counts)
         assert count.size == self._n_ext
-        indptr = np.concatenate([[0], np.cumsum(count)]).astype(PETSc.IntType)
+        rows = np.repeat(np.arange(self._n_ext, dtype=np.int64), count)
+        keys = rows * self._N_red + np.concatenate(cols)
+        values = np.concatenate(vals)
+        order = np.argsort(keys, kind="stable")
+        keys, values = keys[order], values[order]
+        self._P_version = self.transfer.version
+        kept = self._P_keys
+        seen = kept is not None and np.isin(keys, kept, assume_unique=True).all()
+        if kept is not None and self._comm.allreduce(bool(seen), op=MPI.LAND):
+            full = np.zeros(kept.size)
+            full[np.searchsorted(kept, keys)] = values
+            self._set_P(kept, full)
+            return False
+        pattern = keys
+        if hasattr(self.transfer, "reachable_blocks"):
+            reach = self.transfer.reachable_blocks()
+            extra = [self._reachable_keys(reach[i], *selections[i]) for i in selections
+                     if reach[i] is not None]
+            if extra:
+                pattern = np.union1d(keys, np.concatenate(extra))
+        if kept is not None:
+            union = np.union1d(kept, pattern)
+            grown = union.size - pattern.size > KEPT_ZEROS * max(pattern.size - self._n_red, 1)
+            if not self._comm.allreduce(bool(grown), op=MPI.LOR):
+                pattern = union
+        if pattern.size != keys.size:
+            full = np.zeros(pattern.size)
+            full[np.searchsorted(pattern, keys)] = values
+            keys, values = pattern, full
+        self._P_keys = keys
         if self.P is not None:
             self.P.destroy()
+        rows, cols_ = np.divmod(keys, self._N_red)
+        indptr = np.searchsorted(rows, np.arange(self._n_ext + 1)).astype(PETSc.IntType)
         self.P = PETSc.Mat().createAIJ(
             size=((self._n_ext, self._N_ext), (self._n_red, self._N_red)),
-            csr=(indptr, np.concatenate(cols).astype(PETSc.IntType), np.concatenate(vals)),
-            comm=self._comm,
+            csr=(indptr, cols_.astype(PETSc.IntType), values), comm=self._comm,
         )
         self.P.assemble()
-        self._P_version = self.transfer.version
+        return True
+
+    def _reachable_keys(self, near: tuple[np.ndarray, np.ndarray], offset: int,
+                        size: int) -> np.ndarray:
+        """Keys (ext row * N + column) of the blocks each node's rows may come to select.
+
+        ``size`` rows from ``offset``: per node, ``rows`` blocks of bs components.
+        """
+        indptr, blocks = near
+        rows = size // ((indptr.size - 1) * self._bs) if indptr.size > 1 else 0
+        node = np.repeat(np.arange(indptr.size - 1, dtype=np.int64), np.diff(indptr))
+        base = self._reduced_rows(np.asarray(blocks, np.int64))
+        keys = [(offset + (node * rows + r) * self._bs + c) * self._N_red + base + c
+                for r in range(rows) for c in range(self._bs)]
+        return np.concatenate(keys) if keys else np.zeros(0, np.int64)
+
+    def _set_P(self, keys: np.ndarray, values: np.ndarray) -> None:
+        """New values in P's kept pattern (sorted row-major keys row * N + column)."""
+        rows, cols = np.divmod(keys, self._N_red)
+        indptr = np.searchsorted(rows, np.arange(self._n_ext + 1)).astype(PETSc.IntType)
+        start = self.P.getOwnershipRange()[0]
+        self.P.setValuesIJV(indptr, cols.astype(PETSc.IntType), values,
+                            rowmap=np.arange(start, start + self._n_ext, dtype=PETSc.IntType))
+        self.P.assemble()
 
     def _reduced_dofs(self, dofs: np.ndarray) -> np.ndarray:
         """Global reduced rows of global V dofs (block * bs + component)."""
@@ -190,11 +265,10 @@ class CondensedKernel(NewtonKernel):
             self.transfer.refresh()
         if self._P_version != self.transfer.version:
             with stopwatch(self.timings, "transfer_s"):
-                self._build_P()
-                if self.A is not None:
+                if self._build_P() and self.A is not None:
                     self.A.destroy()
                     self.A = None
-                self.rebuilds = getattr(self, "rebuilds", 0) + 1
+                    self.rebuilds = getattr(self, "rebuilds", 0) + 1
 
     # -- assembly ------------------------------------------------------------------
     def _assemble_condensed_jacobian(self) -> None:

@@ -1,0 +1,118 @@
+"""The condensed two-body matrix: open nodes left out exactly, the pattern kept across moves.
+
+Two cylinders (node-to-segment, h = 0.02, 3 GNRM steps, r = 1 E/h) at their
+converged state: about a third of the striker nodes are open far from the
+other cylinder, so the selection P leaves them out (their residual and
+tangent do not depend on the target); P also holds explicit zeros for the
+vertices of the facets around each node's facet, so a move to one of them
+changes values only.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from tangent_check import condensed_tangent_errors
+
+from benchmarks import cases
+from fenics_contact.model.pairs import DeformablePair
+from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.diagnostics import SolverSettings
+
+
+@pytest.fixture(scope="module")
+def solved():
+    problem = cases.build(cases.two_cylinders(0.02, push=0.02), 1.0)
+    strategy = make_strategy("gnrm", problem, SolverSettings())
+    for i in (1, 2, 3):
+        problem.set_load(i / 3)
+        assert strategy.solve().converged
+    pair = next(c.pair for c in problem.contacts if isinstance(getattr(c, "pair", None),
+                                                               DeformablePair))
+    return problem, strategy.kernel, pair
+
+
+def _condensed(kernel) -> tuple[np.ndarray, np.ndarray]:
+    """b and the dense A of the kernel at the current state (serial)."""
+    kernel._pull()
+    kernel._assemble_b()
+    kernel._assemble_A()
+    b = kernel.b.getArray().copy()
+    indptr, indices, values = kernel.A.getValuesCSR()
+    n = kernel.A.getSize()[0]
+    dense = np.zeros((n, n))
+    rows = np.repeat(np.arange(n), np.diff(indptr))
+    dense[rows, indices] = values
+    return b, dense
+
+
+def test_open_nodes_are_left_out_exactly(solved) -> None:
+    problem, kernel, pair = solved
+    if problem.comm.size > 1:
+        pytest.skip("dense comparison in serial")
+    coupled = pair._coupled.copy()
+    assert 0 < coupled.sum() < coupled.size  # some nodes are left out
+    b_pruned, A_pruned = _condensed(kernel)
+    multiplier = pair.multiplier
+    try:
+        pair.multiplier = None  # every node condensed
+        pair._coupled = pair.coupled(pair.target_displacements())
+        pair.version += 1
+        assert pair._coupled.all()
+        b_all, A_all = _condensed(kernel)
+    finally:
+        pair.multiplier = multiplier
+        pair._coupled = coupled
+        pair.version += 1
+    np.testing.assert_allclose(b_pruned, b_all, rtol=0, atol=1e-14 * np.abs(b_all).max())
+    np.testing.assert_allclose(A_pruned, A_all, rtol=0, atol=1e-12 * np.abs(A_all).max())
+
+
+def test_tangent_with_open_nodes_left_out(solved) -> None:
+    problem, _, pair = solved
+    u = problem.u.x.array.copy()
+    rng = np.random.default_rng(3)
+    problem.u.x.array[:] += 1e-4 * rng.standard_normal(u.size)  # off equilibrium
+    problem.u.x.scatter_forward()
+    try:
+        errors = condensed_tangent_errors(problem, rng)
+        assert 0 < pair._coupled.sum() < pair._coupled.size
+    finally:
+        problem.u.x.array[:] = u
+        problem.u.x.scatter_forward()
+    assert min(errors) < 1e-6, errors
+
+
+def test_a_move_to_a_neighbouring_facet_keeps_the_pattern(solved) -> None:
+    problem, kernel, pair = solved
+    if problem.comm.size > 1:
+        pytest.skip("moves one node by hand in serial")
+    kernel._pull()
+    kernel._assemble_b()
+    kernel._assemble_A()
+    matrix = kernel.A
+    node = int(np.flatnonzero(pair._coupled)[0])
+    facet = int(pair.assignment[node])
+    fv = pair.facet_vertex
+    neighbour = next(f for f in range(fv.shape[0])
+                     if f != facet and np.intersect1d(fv[f], fv[facet]).size)
+    far = next(f for f in range(fv.shape[0])
+               if not np.intersect1d(fv[f], fv[facet]).size
+               and not any(np.intersect1d(fv[g], fv[f]).size
+                           for g in range(fv.shape[0]) if np.intersect1d(fv[g], fv[facet]).size))
+    try:
+        pair.assignment[node] = neighbour
+        pair.version += 1
+        kernel._refresh()
+        kernel._assemble_A()
+        assert kernel.A is matrix  # values only: the matrix, its solver and hierarchy kept
+        pair.assignment[node] = far
+        pair.version += 1
+        kernel._refresh()
+        assert kernel.A is None  # a coupling nobody could reach: a new pattern
+        kernel._assemble_A()
+    finally:
+        pair.assignment[node] = facet
+        pair.version += 1
+        kernel._refresh()
+        kernel._assemble_A()
