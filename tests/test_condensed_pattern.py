@@ -116,3 +116,23 @@ def test_a_move_to_a_neighbouring_facet_keeps_the_pattern(solved) -> None:
         pair.version += 1
         kernel._refresh()
         kernel._assemble_A()
+
+
+def test_the_skin_searches_every_node_that_may_be_near(solved) -> None:
+    """Nodes not searched again are far from the target and far in front of their facet."""
+    problem, kernel, pair = solved
+    from fenics_contact.model.pairs import _closest
+
+    n = pair.n_owned
+    points = pair.striker_positions()
+    current = (pair.X_vertices + pair.target_displacements())[pair.facet_vertex]
+    fresh = _closest(current, points, pair._size, pair.assignment)
+    assert pair.searched < points.shape[0]  # the last search skipped some nodes
+    differs = np.flatnonzero(pair.assignment[:n] != fresh.facet[:n])
+    near = fresh.distance[:n] < 2.0 * pair._size
+    assert not np.any(near[differs])  # every node near the target has its closest facet
+    x = current[pair.assignment[differs]]
+    normal = pair._normals(x)
+    normal /= np.linalg.norm(normal, axis=1)[:, None]
+    gap = np.einsum("ij,ij->i", points[differs] - x[:, 0], normal)
+    assert np.all(gap > pair._size)  # and the others are open at any r

@@ -41,6 +41,9 @@ from fenics_contact.model.target_surface import REACH_FACETS, TargetSurface
 #: A node farther than this many facet sizes in front of its facet, with lam >= 0,
 #: is open at any r: the solver's condensation leaves it out (DeformablePair.coupled).
 COUPLING_GAP = 1.0
+#: A frictionless pair searches again only nodes that may have come within this many
+#: facet sizes of the target (DeformablePair._search).
+SKIN = 4.0
 
 
 class DeformablePair:
@@ -131,6 +134,12 @@ class DeformablePair:
         #: node is condensed (see :meth:`coupled`).
         self.multiplier = None
         self._coupled = np.ones(self.W.dofmap.index_map.size_local, bool)
+        # the skin of the search (see _search): per node, how far it may still move
+        self._slack = np.zeros(n_w)
+        self._skin_points: np.ndarray | None = None
+        self._skin_current: np.ndarray | None = None
+        #: Nodes the last search searched (owned and ghost).
+        self.searched = 0
         self.w_prev: list[fem.Function] | None = None
         #: Incremented whenever some striker node changes facet (on any rank).
         self.version = 0
@@ -294,8 +303,54 @@ class DeformablePair:
             self.assignment = np.where(held, np.searchsorted(target.gid, gid), -1)
 
     def _search(self, current: np.ndarray) -> Projection:
-        """Closest target facet of every striker node (current facet vertices given)."""
-        return _closest(current, self.striker_positions(), self._size, self.assignment)
+        """Closest target facet of the striker nodes (current facet vertices given).
+
+        A frictionless pair searches again only the nodes that may have come
+        near: a node found farther than :data:`SKIN` facet sizes keeps its
+        facet while its own motion plus the largest motion of the target
+        since its search leaves it at least that far, its multiplier is not
+        compressive and it stays that far in front of its facet's plane (so
+        it is open, whatever its facet). The others, and every node after the
+        kept facets changed, are searched.
+        """
+        points = self.striker_positions()
+        todo = self._to_search(points, current)
+        if not todo.all():  # a kept facet's plane may have turned towards its node
+            kept = np.flatnonzero(~todo)
+            x = current[self.assignment[kept]]
+            normal = self._normals(x)
+            normal /= np.linalg.norm(normal, axis=1)[:, None]
+            gap = np.einsum("ij,ij->i", points[kept] - x[:, 0], normal)
+            todo[kept[gap <= SKIN * self._size]] = True
+        if todo.all():
+            proj = _closest(current, points, self._size, self.assignment)
+        else:
+            found = _closest(current, points[todo], self._size, self.assignment[todo])
+            old = self.projection
+            proj = Projection(self.assignment.copy(), old.xi.copy(), old.distance.copy(),
+                              old.overshoot.copy())
+            proj.facet[todo], proj.xi[todo] = found.facet, found.xi
+            proj.distance[todo], proj.overshoot[todo] = found.distance, found.overshoot
+        self.searched = int(todo.sum())
+        slack = np.where(todo, proj.distance - SKIN * self._size, self._slack)
+        self._slack, self._skin_points, self._skin_current = slack, points, current
+        return proj
+
+    def _to_search(self, points: np.ndarray, current: np.ndarray) -> np.ndarray:
+        """Which nodes :meth:`_search` must search (bool over owned and ghost W blocks)."""
+        everyone = np.ones(points.shape[0], bool)
+        previous = self._skin_current
+        same = (self.multiplier is not None and previous is not None
+                and previous.shape == current.shape and self.projection is not None
+                and self._skin_points.shape == points.shape)
+        if not self.comm.allreduce(same, op=MPI.LAND):
+            return everyone
+        moved = np.abs(current - previous).max(initial=0.0)
+        moved = self.comm.allreduce(float(np.sqrt(self.gdim) * moved), op=MPI.MAX)
+        self._slack = self._slack - np.linalg.norm(points - self._skin_points, axis=1) - moved
+        self._skin_points = points
+        lam = self.multiplier()
+        return (self._slack <= 0.0) | (lam < 0.0)
 
     def penetration(self) -> np.ndarray:
         """Depth of each owned striker node inside the current target surface (length, >= 0).
