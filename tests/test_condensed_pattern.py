@@ -15,7 +15,7 @@ import pytest
 from tangent_check import condensed_tangent_errors
 
 from benchmarks import cases
-from fenics_contact.model.pairs import DeformablePair
+from fenics_contact.model.pairs import DeformablePair, _closest
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings
 
@@ -120,9 +120,7 @@ def test_a_move_to_a_neighbouring_facet_keeps_the_pattern(solved) -> None:
 
 def test_the_skin_searches_every_node_that_may_be_near(solved) -> None:
     """Nodes not searched again are far from the target and far in front of their facet."""
-    problem, kernel, pair = solved
-    from fenics_contact.model.pairs import _closest
-
+    *_, pair = solved
     n = pair.n_owned
     points = pair.striker_positions()
     current = (pair.X_vertices + pair.target_displacements())[pair.facet_vertex]
