@@ -317,10 +317,7 @@ class DeformablePair:
         todo = self._to_search(points, current)
         if not todo.all():  # a kept facet's plane may have turned towards its node
             kept = np.flatnonzero(~todo)
-            x = current[self.assignment[kept]]
-            normal = self._normals(x)
-            normal /= np.linalg.norm(normal, axis=1)[:, None]
-            gap = np.einsum("ij,ij->i", points[kept] - x[:, 0], normal)
+            gap = self._plane_gaps(points[kept], current[self.assignment[kept]])
             todo[kept[gap <= SKIN * self._size]] = True
         if todo.all():
             proj = _closest(current, points, self._size, self.assignment)
@@ -396,16 +393,18 @@ class DeformablePair:
         n = self.n_owned
         if self.multiplier is None or self.projection is None:
             return np.ones(n, bool)
-        verts = self.facet_vertex[self.assignment[:n]]
-        x = (self.X_vertices + w_t)[verts]
-        normal = self._normals(x)
-        normal /= np.linalg.norm(normal, axis=1)[:, None]
-        points = self.striker_positions()[:n]
+        x = (self.X_vertices + w_t)[self.facet_vertex[self.assignment[:n]]]
         offset = np.asarray(self.gap_offset())
-        gap = np.einsum("ij,ij->i", points - x[:, 0], normal) + (
+        gap = self._plane_gaps(self.striker_positions()[:n], x) + (
             offset[:n] if offset.ndim else offset)
         lam = self.multiplier()[:n]
         return (gap < COUPLING_GAP * self._size) | (lam < 0.0)
+
+    def _plane_gaps(self, points: np.ndarray, facets: np.ndarray) -> np.ndarray:
+        """Signed distance of each point to the plane of its facet (facets: (n, nv, gdim))."""
+        normal = self._normals(facets)
+        normal /= np.linalg.norm(normal, axis=1)[:, None]
+        return np.einsum("ij,ij->i", points - facets[:, 0], normal)
 
     def condensation(self) -> list[sp.csr_matrix]:
         """w_k = S_k u as sparse rows (owned W dofs by global V dofs), open nodes left out."""
@@ -489,6 +488,7 @@ class NodeToSegmentContact(Contact):
         self.self_contact = self_contact
         self.neighbourhood = neighbourhood
         self._target_force_forms: list[fem.Form] | None = None
+        self._lam_of_w: np.ndarray | None = None
 
     def _bind_partner(self, solid) -> ufl.core.expr.Expr:
         if solid.degree != 1:
@@ -516,7 +516,7 @@ class NodeToSegmentContact(Contact):
 
     def _multiplier_at_nodes(self) -> np.ndarray:
         """The multiplier at each W block of the pair (both live on the striker submesh)."""
-        if getattr(self, "_lam_of_w", None) is None:
+        if self._lam_of_w is None:
             W, Q = self.pair.W, self.lam.function_space
             index = np.zeros(W.dofmap.index_map.size_local + W.dofmap.index_map.num_ghosts,
                              np.int64)

@@ -9,13 +9,14 @@ them with P = [[I, 0], [0, I], [S_1, 0], ...]:
 
     R = P^T R_ext,    J = P^T J_ext P     (PETSc MatPtAP)
 
-P keeps the nonzero pattern of every assignment it has held (explicit
-zeros where an entry is not selected now), so that a change of assignment
-that returns to couplings seen before changes values only: the symbolic
-product, the matrix and the linear solver (a direct solver's analysis, a
-multigrid hierarchy's aggregates and prolongators) are kept. The symbolic
-product is redone only when an assignment reaches a column no earlier one
-had, or when the kept zeros outgrow the selection (:data:`KEPT_ZEROS`).
+P holds explicit zeros for the couplings a node may reach next (the
+transfer's ``reachable_blocks``: the vertices of the facets around its
+own) and keeps the pattern of every assignment it has held, so that most
+changes of assignment change values only: the symbolic product, the matrix
+and the linear solver (a direct solver's analysis, a multigrid hierarchy's
+aggregates and prolongators) are kept. The symbolic product is redone only
+when an assignment reaches a column the pattern lacks, or when the kept
+zeros outgrow the fresh pattern (:data:`KEPT_ZEROS`).
 Dirichlet rows and columns are set after the product
 (S couples target vertices that may carry prescribed values): rows hold
 x - x_D and the columns are eliminated with PETSc's ``zeroRowsColumns``,
@@ -43,8 +44,8 @@ from fenics_contact.solvers.timing import stopwatch
 
 _prefix_counter = itertools.count()
 
-#: The pattern of P starts afresh when its kept zeros would outnumber the
-#: selected entries of the extras by more than this factor.
+#: The pattern of P starts afresh when the zeros kept from earlier patterns would
+#: outnumber the fresh pattern's entries on the extras by more than this factor.
 KEPT_ZEROS = 2.0
 
 
@@ -130,51 +131,17 @@ class CondensedKernel(NewtonKernel):
         """P: extended rows to reduced columns; identity on unknowns, dw/du on extras.
 
         Returns True when P is a new matrix (a new pattern), False when only its
-        values changed.
-
-        An extra is either a 0/1 selection of V blocks (``sources()``) or, when
-        the transfer has ``condensation()``, any sparse derivative of the extra
-        with respect to u (rows: its owned dofs; columns: global V dofs).
+        values changed (the selection fits the kept pattern).
         """
-        rank = self._comm.rank
-        counts = [np.ones(self._n_red, np.int64)]
-        cols = [self._red0[rank] + np.arange(self._n_red, dtype=np.int64)]
-        vals = [np.ones(self._n_red)]
-        selections = {}  # item index -> (first extended row, number of rows)
-        offset = self._n_red
-        for i, item in enumerate(_condensation(self.transfer)):
-            if isinstance(item, np.ndarray):
-                item = np.asarray(item, np.int64)
-                base = self._reduced_rows(item.reshape(-1))
-                # a 2D source (node, row) selects for a packed coefficient of shape (rows, bs)
-                col = (base[:, None] + np.arange(self._bs)[None, :]).reshape(-1)
-                selections[i] = (offset, col.size)
-                offset += col.size
-                counts.append(np.ones(col.size, np.int64))
-                cols.append(col)
-                vals.append(np.ones(col.size))
-            else:
-                rows = item.tocsr()
-                rows.sort_indices()
-                counts.append(np.diff(rows.indptr).astype(np.int64))
-                cols.append(self._reduced_dofs(rows.indices.astype(np.int64)))
-                vals.append(rows.data)
-                selections[i] = (offset, rows.shape[0])
-                offset += rows.shape[0]
-        count = np.concatenate(counts)
-        assert count.size == self._n_ext
-        rows = np.repeat(np.arange(self._n_ext, dtype=np.int64), count)
-        keys = rows * self._N_red + np.concatenate(cols)
-        values = np.concatenate(vals)
-        order = np.argsort(keys, kind="stable")
-        keys, values = keys[order], values[order]
+        keys, values, selections = self._selection()
         self._P_version = self.transfer.version
         kept = self._P_keys
         seen = kept is not None and np.isin(keys, kept, assume_unique=True).all()
         if kept is not None and self._comm.allreduce(bool(seen), op=MPI.LAND):
-            full = np.zeros(kept.size)
-            full[np.searchsorted(kept, keys)] = values
-            self._set_P(kept, full)
+            self.P.setValuesIJV(*self._csr(kept), _spread(kept, keys, values),
+                                rowmap=np.arange(*self.P.getOwnershipRange(),
+                                                 dtype=PETSc.IntType))
+            self.P.assemble()
             return False
         pattern = keys
         if hasattr(self.transfer, "reachable_blocks"):
@@ -188,21 +155,58 @@ class CondensedKernel(NewtonKernel):
             grown = union.size - pattern.size > KEPT_ZEROS * max(pattern.size - self._n_red, 1)
             if not self._comm.allreduce(bool(grown), op=MPI.LOR):
                 pattern = union
-        if pattern.size != keys.size:
-            full = np.zeros(pattern.size)
-            full[np.searchsorted(pattern, keys)] = values
-            keys, values = pattern, full
-        self._P_keys = keys
+        self._P_keys = pattern
         if self.P is not None:
             self.P.destroy()
-        rows, cols_ = np.divmod(keys, self._N_red)
-        indptr = np.searchsorted(rows, np.arange(self._n_ext + 1)).astype(PETSc.IntType)
         self.P = PETSc.Mat().createAIJ(
             size=((self._n_ext, self._N_ext), (self._n_red, self._N_red)),
-            csr=(indptr, cols_.astype(PETSc.IntType), values), comm=self._comm,
+            csr=(*self._csr(pattern), _spread(pattern, keys, values)), comm=self._comm,
         )
         self.P.assemble()
         return True
+
+    def _selection(self) -> tuple[np.ndarray, np.ndarray, dict[int, tuple[int, int]]]:
+        """This rank's entries of P as sorted keys (ext row * N + column) and values.
+
+        An extra is either a 0/1 selection of V blocks (``sources()``) or, when
+        the transfer has ``condensation()``, any sparse derivative of the extra
+        with respect to u (rows: its owned dofs; columns: global V dofs). Also
+        returns, per extra, its first extended row and its number of rows.
+        """
+        rank = self._comm.rank
+        counts = [np.ones(self._n_red, np.int64)]
+        cols = [self._red0[rank] + np.arange(self._n_red, dtype=np.int64)]
+        vals = [np.ones(self._n_red)]
+        selections = {}
+        offset = self._n_red
+        for i, item in enumerate(_condensation(self.transfer)):
+            if isinstance(item, np.ndarray):
+                base = self._reduced_rows(np.asarray(item, np.int64).reshape(-1))
+                # a 2D source (node, row) selects for a packed coefficient of shape (rows, bs)
+                col = (base[:, None] + np.arange(self._bs)[None, :]).reshape(-1)
+                counts.append(np.ones(col.size, np.int64))
+                cols.append(col)
+                vals.append(np.ones(col.size))
+            else:
+                rows = item.tocsr()
+                rows.sort_indices()
+                counts.append(np.diff(rows.indptr).astype(np.int64))
+                cols.append(self._reduced_dofs(rows.indices.astype(np.int64)))
+                vals.append(rows.data)
+            selections[i] = (offset, counts[-1].size)
+            offset += counts[-1].size
+        count = np.concatenate(counts)
+        assert count.size == self._n_ext
+        rows = np.repeat(np.arange(self._n_ext, dtype=np.int64), count)
+        keys = rows * self._N_red + np.concatenate(cols)
+        order = np.argsort(keys, kind="stable")
+        return keys[order], np.concatenate(vals)[order], selections
+
+    def _csr(self, keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Row pointers and columns of this rank's rows of P from sorted keys."""
+        rows, cols = np.divmod(keys, self._N_red)
+        indptr = np.searchsorted(rows, np.arange(self._n_ext + 1))
+        return indptr.astype(PETSc.IntType), cols.astype(PETSc.IntType)
 
     def _reachable_keys(self, near: tuple[np.ndarray, np.ndarray], offset: int,
                         size: int) -> np.ndarray:
@@ -217,15 +221,6 @@ class CondensedKernel(NewtonKernel):
         keys = [(offset + (node * rows + r) * self._bs + c) * self._N_red + base + c
                 for r in range(rows) for c in range(self._bs)]
         return np.concatenate(keys) if keys else np.zeros(0, np.int64)
-
-    def _set_P(self, keys: np.ndarray, values: np.ndarray) -> None:
-        """New values in P's kept pattern (sorted row-major keys row * N + column)."""
-        rows, cols = np.divmod(keys, self._N_red)
-        indptr = np.searchsorted(rows, np.arange(self._n_ext + 1)).astype(PETSc.IntType)
-        start = self.P.getOwnershipRange()[0]
-        self.P.setValuesIJV(indptr, cols.astype(PETSc.IntType), values,
-                            rowmap=np.arange(start, start + self._n_ext, dtype=PETSc.IntType))
-        self.P.assemble()
 
     def _reduced_dofs(self, dofs: np.ndarray) -> np.ndarray:
         """Global reduced rows of global V dofs (block * bs + component)."""
@@ -327,6 +322,13 @@ class CondensedKernel(NewtonKernel):
                     self.dx, self.z):
             if obj is not None:
                 obj.destroy()
+
+
+def _spread(pattern: np.ndarray, keys: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Values on ``pattern`` (sorted keys): ``values`` at ``keys``, explicit zeros elsewhere."""
+    out = np.zeros(pattern.size)
+    out[np.searchsorted(pattern, keys)] = values
+    return out
 
 
 def _condensation(transfer) -> list:
