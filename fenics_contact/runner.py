@@ -28,7 +28,7 @@ from fenics_contact.scene.schema import Scene
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.base import SolveResult
 from fenics_contact.solvers.linear import LinearSolverSettings
-from fenics_contact.solvers.predictor import Extrapolated
+from fenics_contact.solvers.predictor import ActiveSetPredicted, Extrapolated
 from fenics_contact.solvers.stepping import RunRecord, StepRecord, solve_load_path, start_record
 from fenics_contact.stop import StopRequested
 
@@ -259,6 +259,8 @@ def run_scene(
     saved = restore(out / "checkpoint", problem, marker) if marker is not None else None
     if isinstance(strategy, Extrapolated) and saved is not None and saved.history:
         strategy.history = saved.history
+        if isinstance(strategy, ActiveSetPredicted):
+            strategy.gap_history = saved.gaps
     record = start_record(strategy)
     record.steps = [StepRecord(**r) for r in saved.records] if saved is not None else []
     first = saved.step + 1 if saved is not None else 1
@@ -273,8 +275,9 @@ def run_scene(
     def finished(step: StepRecord) -> None:
         writer.write(step.load_factor)
         history = strategy.history if isinstance(strategy, Extrapolated) else []
+        gaps = strategy.gap_history if isinstance(strategy, ActiveSetPredicted) else []
         checkpoint.write(step.step, [s.to_dict() for s in record.steps], history,
-                         files=writer.written)
+                         files=writer.written, gaps=gaps)
         _write_summary(comm, out, scene, record, used)
         if on_step is not None:
             on_step(step)

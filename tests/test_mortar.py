@@ -262,8 +262,10 @@ def test_a_striker_pushed_through_the_target_in_one_step_is_refused_then_cut_bac
 
     shipped = Path(__file__).parents[1] / "scenes" / "block_on_block.toml"
     text = shipped.read_text().replace('"../meshes/', f'"{shipped.parents[1]}/meshes/')
+    # from the last state: the active-set default starts the touching face in contact,
+    # and that first iterate stays out of the target
     text = text.replace('value = ["free", -0.01]', 'value = ["free", -0.3]').replace(
-        "steps = 2", "steps = 1")
+        "steps = 2", 'steps = 1\npredictor = "previous"')
     scene = tmp_path / "deep.toml"
     scene.write_text(text)
     outcome = run_scene(load_scene(scene), tmp_path / "out", comm=MPI.COMM_SELF, pictures=False)

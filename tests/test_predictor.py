@@ -158,3 +158,36 @@ def test_active_set_predictor_resumed_history_has_no_gaps() -> None:
     problem.set_load(1.0)
     assert strategy.predict()
     assert strategy.inner.solve().converged
+
+
+def test_active_set_predictor_round_off_pressure_is_an_open_node() -> None:
+    """A node that lifted off with lam = -1e-96 left from its iterations stays open.
+
+    Such a node once counted as in contact and was pulled back onto the
+    target from afar (the shipped ironing scene diverged). The same state
+    with the round-off pressure removed gives the same guess.
+    """
+    problem = cases.build(CYLINDER, 1.0, relative=True, quadrature="nodal")
+    strategy = make_strategy("gnrm", problem, SolverSettings(atol=1e-8), predictor="active-set")
+    assert solve_load_path(strategy, 10, last_step=5).status == "partial"
+    contact = problem.contacts[0]
+    g = contact.surface.nodal(contact._gap_form)
+    lam = contact.lam.x.array
+    far = int(np.argmax(np.where(lam[:g.size] == 0.0, g, -np.inf)))
+    assert g[far] > contact.surface.h
+    guesses = []
+    for value in (0.0, -1e-96):
+        lam[far] = value
+        t, u, lam_n = strategy.history[-1]
+        lam_n[far] = value
+        strategy._history[-1] = (t, u, lam_n)
+        problem.set_load(0.6)
+        assert strategy.predict()
+        guesses.append(contact.lam.x.array.copy())
+        g_pred = contact.surface.nodal(contact._gap_form)
+        assert guesses[-1][far] + float(contact.r.value) * g_pred[far] > 0.0  # open
+        problem.u.x.array[:] = u  # back to the last converged state
+        contact.lam.x.array[:] = lam_n
+        problem.set_load(t)
+    assert np.array_equal(guesses[0][:g.size][np.arange(g.size) != far],
+                          guesses[1][:g.size][np.arange(g.size) != far])

@@ -229,7 +229,7 @@ def test_a_log_gets_one_line_per_load_step(tmp_path, capsys):
     assert main(["run", str(scene), "--out", str(tmp_path / "out"), "--no-pictures"]) == 0
     err = capsys.readouterr().err.splitlines()
     assert err == [
-        "block-on-block: load step 1/2 converged, load factor 0.5, 2 Newton iterations, "
+        "block-on-block: load step 1/2 converged, load factor 0.5, 1 Newton iteration, "
         "contact force 1.0989",
         "block-on-block: load step 2/2 converged, load factor 1, 0 Newton iterations, "
         "contact force 2.1978",

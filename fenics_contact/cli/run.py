@@ -121,9 +121,10 @@ def _solve(
         finished[0] = record.step
         bar.update(1)
         if not (quiet or terminal):
+            newton = _count(record.iterations, "Newton iteration")
             print(f"{scene.name}: load step {record.step}/{steps} {record.status}, load factor "
-                  f"{record.load_factor:.4g}, {record.iterations} Newton iterations, contact "
-                  f"force {record.contact_force:.6g}", file=sys.stderr, flush=True)
+                  f"{record.load_factor:.4g}, {newton}, contact force "
+                  f"{record.contact_force:.6g}", file=sys.stderr, flush=True)
         stop.check()
 
     stop.check()  # a signal while the scene was read
@@ -147,14 +148,19 @@ def _solve(
     if not quiet:
         s = outcome.summary
         print(
-            f"{scene.name}: converged, {s['iterations']} Newton iterations in "
-            f"{s['load_steps']} steps, {s['wall_s']:.1f} s; contact force "
+            f"{scene.name}: converged, {_count(s['iterations'], 'Newton iteration')} in "
+            f"{_count(s['load_steps'], 'step')}, {s['wall_s']:.1f} s; contact force "
             f"{path.steps[-1].contact_force:.6g}, max penetration "
             f"{_penetration(scene, outcome.problem, path.steps[-1].max_penetration)}"
             f"\nWrote {out}/solution.xdmf, summary.json"
             + ("" if args.no_pictures or not scene.pictures else ", deformed.png, residuals.png")
         )
     return 0
+
+
+def _count(n: int, noun: str) -> str:
+    """'1 step', '2 steps'."""
+    return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
 
 
 def _advice(scene: Scene, status: str) -> str:

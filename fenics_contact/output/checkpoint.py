@@ -36,7 +36,7 @@ import json
 import re
 import zipfile
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -79,12 +79,15 @@ class Checkpoint:
         records: the step records (dicts) of steps 1 .. step, for summary.json.
         history: the predictor's converged states (load factor, full local
             displacement, full local multiplier arrays, ghosts included), oldest first.
+        gaps: the nodal gaps of those states, when the predictor keeps them
+            (owned values joined over the contacts; empty otherwise).
     """
 
     step: int
     load_factor: float
     records: list[dict]
     history: list[tuple[float, np.ndarray, np.ndarray]]
+    gaps: list[np.ndarray] = field(default_factory=list)
 
 
 def _file_digest(path: Path) -> str:
@@ -308,8 +311,12 @@ class CheckpointWriter:
         records: list[dict],
         history: list[tuple[float, np.ndarray, np.ndarray]] = (),  # type: ignore[assignment]
         files: Sequence[Path] = (),
+        gaps: Sequence[np.ndarray] = (),
     ) -> None:
         """Save the state after load step ``step`` (records: steps 1 .. step).
+
+        ``history`` and ``gaps``: the predictor's converged states and their
+        nodal gaps (:class:`Checkpoint`).
 
         ``files``: output files (closed) that a resume must find unchanged;
         their sizes and SHA-256 go into ``latest.json``.
@@ -331,6 +338,8 @@ class CheckpointWriter:
                 history_u=np.array([h[1][:nu] for h in history]).reshape(len(history), nu),
                 history_lam=np.array([_owned_joined(p, h[2]) for h in history]).reshape(
                     len(history), nl),
+                history_gap=np.array(list(gaps), dtype=np.float64).reshape(
+                    len(gaps), gaps[0].size if len(gaps) else 0),
                 **self._coordinates,
             )
         except OSError as exc:
@@ -414,8 +423,9 @@ def restore(folder: Path, problem: ContactProblem, marker: dict) -> Checkpoint:
         for t, hu, hl in zip(data["history_t"], data["history_u"], data["history_lam"],
                              strict=True)
     ]
+    gaps = list(data.get("history_gap", np.zeros((0, 0))))  # absent in older checkpoints
     comm.Barrier()
-    return Checkpoint(step, float(data["load_factor"]), list(marker["records"]), history)
+    return Checkpoint(step, float(data["load_factor"]), list(marker["records"]), history, gaps)
 
 
 __all__ = [

@@ -249,10 +249,10 @@ KEY_DOCS: dict[str, dict[str, KeyDoc]] = {
                        "(0 disables).", field="SolverSpec.rtol"),
         "max_cutbacks": KeyDoc("integer >= 0", "Halvings of a failed load increment before "
                                "the run stops.", field="SolverSpec.max_cutbacks"),
-        "predictor": KeyDoc('"extrapolate" | "previous" | "active-set"', "Start a step from "
-                            "the linear extrapolation of the last two, or from the last one; "
-                            "active-set: extrapolate and choose the first iteration's contact "
-                            "set from the gaps' history.",
+        "predictor": KeyDoc('"active-set" | "extrapolate" | "previous"', "Start a step from "
+                            "the linear extrapolation of the last two converged states with the "
+                            "first iteration's contact set chosen from the gaps' history; from "
+                            "the extrapolation alone; or from the last state.",
                             field="SolverSpec.predictor"),
         "linear_solver": KeyDoc('"direct" | "iterative"', "MUMPS, or GMRES with a Schur field "
                                 "split and algebraic multigrid (large 3D).",

@@ -39,10 +39,10 @@ Layout (units are the user's; be consistent)::
     [pairing]    automatic = true (every body against every other, instead of or
                  besides [[pair]]), r, relative, mu, tangential_r_max, margin
     [solver]     method, steps, max_iterations, atol, rtol, max_cutbacks,
-                 predictor = "extrapolate" (start a step from the linear
-                 extrapolation of the last two) | "previous" | "active-set"
-                 (extrapolate, and the first iteration's contact set from
-                 the gaps' history),
+                 predictor = "active-set" (start a step from the linear
+                 extrapolation of the last two, the first iteration's
+                 contact set from the gaps' history) | "extrapolate" |
+                 "previous",
                  linear_solver = "direct" (MUMPS) | "iterative" (GMRES,
                  Schur field split, algebraic multigrid; for large 3D),
                  forcing = "fixed" | "eisenstat-walker" and

@@ -150,7 +150,7 @@ class SolverSpec(SolverSettings):
     method: str = "gnrm"
     steps: int = 10
     max_cutbacks: int = 4
-    predictor: str = "extrapolate"
+    predictor: str = "active-set"
     linear_solver: str = "direct"
     forcing: str = "fixed"
     reuse_preconditioner: str = "no"

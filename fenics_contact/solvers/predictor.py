@@ -15,11 +15,14 @@ closed. It is only a starting guess: the converged answer is the same.
 :class:`ActiveSetPredicted` starts from the same extrapolation and also
 chooses the contact set of the first Newton iteration (nodal-rule,
 frictionless contacts): a node open in the last two states closes when the
-linear extrapolation of ``g**(2/3)`` reaches zero (near the edge of a smooth
+extrapolated state closes it and the linear extrapolation of ``g**(2/3)``
+reaches zero as well (near the edge of a smooth
 contact the gap grows as the distance to the edge to the power 3/2, so
 ``g**(2/3)`` moves linearly with the edge, while the gap itself closes
 tangentially and its linear extrapolation closes nodes too early); a node in
-contact stays in contact unless its extrapolated multiplier turns tensile.
+contact stays in contact unless its extrapolated multiplier turns tensile (a
+pressure that round-off leaves on an open node, below 1e-9 of the largest,
+does not make it a node in contact).
 At the first step, from rest, the nodes that touch (g = 0) start in
 contact instead of none. The choice is imposed through the multiplier
 (lam + r g just below zero for a node set in contact, at or above zero for a
@@ -143,9 +146,9 @@ class ActiveSetPredicted(Extrapolated):
 
     See the module's description. Contacts with friction, or with a
     quadrature other than the vertex rule, are only extrapolated. A history
-    set from outside (a resumed run) has no gaps: the first step after it
-    decides the set by the sign of the extrapolated lam + r g, as
-    :class:`Extrapolated` does.
+    set from outside (a resumed run) has no gaps unless :attr:`gap_history`
+    is set too: without them the first step after it decides the set by the
+    sign of the extrapolated lam + r g, as :class:`Extrapolated` does.
 
     Args:
         strategy: the strategy that does the solving (e.g. GNRM).
@@ -182,6 +185,43 @@ class ActiveSetPredicted(Extrapolated):
         Extrapolated.history.fset(self, states)  # type: ignore[attr-defined]
         self._gaps = []
 
+    @property
+    def gap_history(self) -> list[np.ndarray]:
+        """The nodal gaps of the converged states (length), oldest first, one per state.
+
+        Each is joined over the contacts in the layout of their owned
+        multiplier values (NaN on a contact whose set is not chosen here).
+        Set it after :attr:`history` (a resumed run) to continue exactly as
+        the uninterrupted run; arrays of another length are ignored.
+        """
+        chosen = {id(c): k for k, c in enumerate(self._chosen())}
+        out = []
+        for gaps in self._gaps:
+            parts = []
+            for c in self.problem.contacts:
+                n = c.lam.x.index_map.size_local
+                k = chosen.get(id(c))
+                parts.append(gaps[k] if k is not None else np.full(n, np.nan))
+            out.append(np.concatenate(parts) if parts else np.zeros(0))
+        return out
+
+    @gap_history.setter
+    def gap_history(self, joined: list[np.ndarray]) -> None:
+        chosen = {id(c) for c in self._chosen()}
+        sizes = [c.lam.x.index_map.size_local for c in self.problem.contacts]
+        gaps = []
+        for array in joined[-2:]:
+            if array.size != sum(sizes):
+                return
+            parts, start = [], 0
+            for c, n in zip(self.problem.contacts, sizes, strict=True):
+                if id(c) in chosen:
+                    parts.append(np.array(array[start:start + n]))
+                start += n
+            gaps.append(parts)
+        if len(gaps) == len(self._history):
+            self._gaps = gaps
+
     def _offsets(self) -> dict[int, int]:
         """Where each contact's lam starts in the joined multiplier array."""
         out, start = {}, 0
@@ -212,11 +252,14 @@ class ActiveSetPredicted(Extrapolated):
                 g0, g1 = gaps[0][k], gaps[1][k]
                 both = (g0 > 0.0) & (g1 > 0.0)
                 h0, h1 = np.abs(g0) ** p, np.abs(g1) ** p
-                closing = np.where(both, h1 + s * (h1 - h0) <= 0.0, closing)
-            was_active = last < 0.0
-            active = np.where(was_active, lam < 0.0, closing)
+                # the edge rule only delays a closure the extrapolated state predicts: a gap
+                # that jumped (a node that found its facet, or lost a lift) proves nothing
+                closing = np.where(both, closing & (h1 + s * (h1 - h0) <= 0.0), closing)
             scale = comm.allreduce(float(np.max(np.abs(np.concatenate([last, before])),
                                                 initial=0.0)), op=MPI.MAX)
+            floor = self.margin * scale  # a pressure below this is round-off (an open node)
+            was_active = last < -floor
+            active = np.where(was_active, lam < 0.0, closing)
             r = float(c.r.value)
             tiny = self.margin * max(scale, 1e-6 * r * c.surface.h)
             augmented = lam + r * g_pred
