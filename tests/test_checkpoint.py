@@ -151,3 +151,30 @@ def test_a_resumed_frictional_run_repeats_the_uninterrupted_one(tmp_path, method
             b.iterations, b.tangential_force, b.contact_force, b.stick_count), a.step
     assert np.array_equal(full.problem.u.x.array, resumed.problem.u.x.array)
     assert 0 < full.path.steps[6].stick_count  # step 7 has sticking nodes: the history counts
+
+
+def test_a_resumed_run_keeps_the_active_set_predictors_gaps(tmp_path):
+    """The active-set predictor chooses a step's first set from the last two states' gaps.
+
+    Stopped after step 2 of 4, the resumed Hertz cylinder must repeat every
+    step of the uninterrupted run to the last bit. (Without the gaps in the
+    checkpoint the steps after the resume decided their set by the
+    extrapolated lam + r g alone: 3 iterations instead of 1 at steps 3 and 4.)
+    """
+    from fenics_contact.runner import run_scene
+
+    scene = load_scene(SCENES / "hertz_cylinder.toml")
+    assert scene.solver.predictor == "active-set"
+    full = run_scene(scene, tmp_path / "full", comm=MPI.COMM_SELF, pictures=False)
+
+    def stop(step):
+        if step.step == 2:
+            raise _Stop
+
+    with pytest.raises(_Stop):
+        run_scene(scene, tmp_path / "part", comm=MPI.COMM_SELF, pictures=False, on_step=stop)
+    resumed = run_scene(scene, tmp_path / "part", comm=MPI.COMM_SELF, pictures=False,
+                        resume=True)
+    assert full.path.converged and resumed.path.converged
+    assert [s.iterations for s in full.path.steps] == [s.iterations for s in resumed.path.steps]
+    assert np.array_equal(full.problem.u.x.array, resumed.problem.u.x.array)
