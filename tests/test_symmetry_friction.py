@@ -160,3 +160,41 @@ def test_two_body_half_model_with_friction_converges(tmp_path):
     on_plane = np.isclose(x, 0.0)
     assert np.all(state.tangential_traction[on_plane] == 0.0)
     assert np.abs(state.tangential_traction[~on_plane]).max() > 1e-2  # friction acts elsewhere
+
+
+def _hemispheres(tmp_path: Path, name: str, mu: float | None, striker_E: float = 200.0):
+    root = Path(__file__).parent.parent
+    text = (root / "scenes" / "two_hemispheres_3d_node_to_segment.toml").read_text()
+    text = text.replace('"../meshes/', f'"{root / "meshes"}/')
+    if mu is not None:
+        text = text.replace('target = "target_cap"', f'target = "target_cap"\nmu = {mu}', 1)
+    text = text.replace("E = 200.0", f"E = {striker_E}", 1) + "\n[output]\npictures = false\n"
+    path = tmp_path / f"{name}.toml"
+    path.write_text(text)
+    outcome = run_scene(load_scene(path), tmp_path / name, comm=MPI.COMM_SELF)
+    assert outcome.path.status == "converged", outcome.path.steps[-1].message
+    return outcome
+
+
+def test_quarter_model_of_two_frictional_hemispheres(tmp_path):
+    """Two curved faceted surfaces cut by the planes x = 0 and y = 0, with friction.
+
+    The target facets along a plane lie on one side of it, so their normal is
+    not quite in the plane: the frame there is built in the plane (its first
+    tangent the plane's normal). Before, the scene was refused (|t . e_x| =
+    0.996). Identical linear materials under a normal load do not slip
+    (Goodman): the normal force is the frictionless one and the friction force
+    is the meshes' asymmetry only (measured: 4.3e-5 and 0.8 % of mu P).
+    """
+    frictionless = _hemispheres(tmp_path, "plain", None).problem.contact_states()
+    outcome = _hemispheres(tmp_path, "friction", 0.3)
+    problem = outcome.problem
+    assert problem.symmetry_constraints > 0
+    state = next(iter(problem.contact_states().values()))
+    normal = next(iter(frictionless.values())).contact_force
+    assert state.contact_force == pytest.approx(normal, rel=1e-3)
+    assert outcome.path.steps[-1].tangential_force <= 0.02 * 0.3 * state.contact_force
+    assert outcome.path.steps[-1].slip_count == 0
+    # a stiffer striker expands less sideways: the interface slips, the model still converges
+    stiff = _hemispheres(tmp_path, "stiff", 0.3, striker_E=1000.0).path.steps[-1]
+    assert stiff.slip_count > 0 and stiff.tangential_force > 0.0

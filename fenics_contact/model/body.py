@@ -281,6 +281,17 @@ class Solid:
                 bcs.append(fem.dirichletbc(const, dofs, Vi))
         return bcs
 
+    def symmetry_plane_axes(self) -> tuple[fem.Function, fem.Function] | None:
+        """The symmetry planes' nodal data (:func:`~.friction.plane_axes`; None without).
+
+        Collective on first call (it finds the planes), cached after.
+        """
+        if not hasattr(self, "_plane_axes"):
+            from fenics_contact.model.friction import plane_axes, symmetry_planes
+
+            self._plane_axes = plane_axes(self.V, symmetry_planes(self.domain, self.prescribed))
+        return self._plane_axes
+
     def set_load(self, t: float) -> None:
         """Set every prescribed component and traction to its value at load factor t."""
         for const, condition, i in self._bc_constants:

@@ -65,7 +65,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import ufl
-from dolfinx import mesh
+from dolfinx import fem, mesh
 
 from mpi4py import MPI
 
@@ -126,6 +126,58 @@ def symmetry_planes(
         if np.isfinite(lo) and hi - lo <= 1e-12 * span:
             planes.append((facets, axis))
     return planes
+
+
+def plane_axes(V: fem.FunctionSpace, planes: list[tuple[np.ndarray, int]],
+               ) -> tuple[fem.Function, fem.Function] | None:
+    """Nodal data of the symmetry planes for a pair's tangent frame (None without planes).
+
+    Returns (keep, axis), two functions of the vector P1 space ``V``: ``keep``
+    is 1 but for the component across each plane at the nodes on it (0), and
+    ``axis`` is the unit normal of the first plane through a node (0 at nodes
+    on none). See :func:`symmetric_frame`.
+    """
+    if not planes:
+        return None
+    keep, axis = fem.Function(V, name="plane_keep"), fem.Function(V, name="plane_axis")
+    keep.x.array[:] = 1.0
+    gdim = V.mesh.geometry.dim
+    fdim = V.mesh.topology.dim - 1
+    first = np.zeros(keep.x.array.size // gdim, dtype=bool)
+    for facets, a in planes:
+        blocks = fem.locate_dofs_topological(V, fdim, facets)
+        keep.x.array[blocks * gdim + a] = 0.0
+        fresh = blocks[~first[blocks]]
+        axis.x.array[fresh * gdim + a] = 1.0
+        first[blocks] = True
+    keep.x.scatter_forward()
+    axis.x.scatter_forward()
+    return keep, axis
+
+
+def symmetric_frame(n: ufl.core.expr.Expr, gdim: int,
+                    planes: tuple[fem.Function, fem.Function] | None) -> ufl.core.expr.Expr:
+    """The tangents of ``n`` (:func:`tangent_basis`), exact at nodes on symmetry planes.
+
+    The normal of a symmetric surface lies in each symmetry plane through it,
+    but a faceted target's does not quite (its facets lie on one side of the
+    plane). At a node on a plane the frame is built from n with its
+    components across the planes removed, and in 3D its first tangent is the
+    plane's normal e_a (the second n x e_a), so that the traction across the
+    plane is one frame component, which the symmetry constrains to zero.
+    Elsewhere it is :func:`tangent_basis` of n. ``planes``: :func:`plane_axes`.
+    """
+    if planes is None:
+        return tangent_basis(n, gdim)
+    keep, e = planes
+    m = ufl.elem_mult(keep, n)
+    n_in = m / ufl.max_value(ufl.sqrt(ufl.dot(m, m)), 1e-300)
+    if gdim == 2:
+        return tangent_basis(n_in, gdim)
+    on = ufl.dot(e, e)  # 1 at nodes on a plane, 0 elsewhere
+    second = ufl.cross(n_in, e)
+    in_plane = ufl.as_matrix([[e[i], second[i]] for i in range(3)])
+    return on * in_plane + (1.0 - on) * tangent_basis(n_in, gdim)
 
 
 def coulomb_projection(

@@ -385,7 +385,8 @@ class MortarContact(Contact):
         """
         from fenics_contact.model.pairs import slip_at_projection
 
-        return slip_at_projection(self.slip_pair, self.solid.u, u_prev, self.gdim)
+        return slip_at_projection(self.slip_pair, self.solid.u, u_prev, self.gdim,
+                                  self.solid.symmetry_plane_axes())
 
     def commit_frame(self) -> None:
         """The previous frame <- the new u_prev (the projections' target vertices)."""

@@ -33,7 +33,7 @@ from mpi4py import MPI
 from fenics_contact.model.body import Body
 from fenics_contact.model.contact import ContactSettings, ContactSurface
 from fenics_contact.model.contacts import Contact
-from fenics_contact.model.friction import FrictionSettings, tangent_basis
+from fenics_contact.model.friction import FrictionSettings, symmetric_frame
 from fenics_contact.model.search import TIE_TOL, Projection, SurfaceSearch, penetration_depth
 from fenics_contact.model.segments import node_blocks
 from fenics_contact.model.target_surface import REACH_FACETS, TargetSurface
@@ -546,7 +546,8 @@ class NodeToSegmentContact(Contact):
     # -- friction -----------------------------------------------------------------------
     def slip_increment(self, u_prev: fem.Function) -> tuple[ufl.core.expr.Expr, ufl.core.expr.Expr]:
         """T of the target facet and the relative slip (:func:`slip_at_projection`)."""
-        return slip_at_projection(self.pair, self.solid.u, u_prev, self.gdim)
+        return slip_at_projection(self.pair, self.solid.u, u_prev, self.gdim,
+                                  self.solid.symmetry_plane_axes())
 
     def commit_frame(self) -> None:
         """w_k_prev <- the assigned vertices' displacements in the new u_prev."""
@@ -609,7 +610,8 @@ def _closest(current: np.ndarray, points: np.ndarray, size: float,
 
 
 def slip_at_projection(pair: DeformablePair, u: fem.Function, u_prev: fem.Function,
-                       gdim: int) -> tuple[ufl.core.expr.Expr, ufl.core.expr.Expr]:
+                       gdim: int, planes: tuple[fem.Function, fem.Function] | None = None,
+                       ) -> tuple[ufl.core.expr.Expr, ufl.core.expr.Expr]:
     """T of the target facet and the relative slip of a striker node and its projection.
 
     dg_t = T^T [(x_s - x_s_prev) - (x_p - x_p_prev)] with x_p = sum_k N_k x_k
@@ -618,11 +620,13 @@ def slip_at_projection(pair: DeformablePair, u: fem.Function, u_prev: fem.Functi
     w_k_prev, the previous displacements of the assigned vertices, are data
     filled by the search from u_prev. Under a common rigid translation
     dg_t = 0 and its derivative vanishes, so the friction forces on the
-    striker and on the target balance exactly.
+    striker and on the target balance exactly. ``planes``: the symmetry
+    planes' nodal data (:func:`~.friction.plane_axes`), for a frame that
+    holds the plane's normal at the nodes on it (:func:`~.friction.symmetric_frame`).
     """
     w_prev = pair.track_previous(u_prev)
     x_s = ufl.SpatialCoordinate(u.function_space.mesh) + u
-    tangents = tangent_basis(pair.normal(), gdim)
+    tangents = symmetric_frame(pair.normal(), gdim, planes)
     target = sum(
         (N * (wk - wk_prev)
          for N, wk, wk_prev in zip(pair.shape_weights(x_s), pair.w, w_prev, strict=True)),
