@@ -114,6 +114,24 @@ class _Stop(Exception):
     """Stands for a run stopped after a given step."""
 
 
+def _full_and_resumed(scene, tmp_path: Path, stop_after: int) -> tuple:
+    """The uninterrupted run, and the run stopped after ``stop_after`` steps then resumed."""
+    from fenics_contact.runner import run_scene
+
+    full = run_scene(scene, tmp_path / "full", comm=MPI.COMM_SELF, pictures=False)
+
+    def stop(step):
+        if step.step == stop_after:
+            raise _Stop
+
+    with pytest.raises(_Stop):
+        run_scene(scene, tmp_path / "part", comm=MPI.COMM_SELF, pictures=False, on_step=stop)
+    resumed = run_scene(scene, tmp_path / "part", comm=MPI.COMM_SELF, pictures=False,
+                        resume=True)
+    assert full.path.converged and resumed.path.converged
+    return full, resumed
+
+
 @pytest.mark.parametrize(("method", "r"), [("gnrm", 1.0), ("penalty", 100.0)])
 def test_a_resumed_frictional_run_repeats_the_uninterrupted_one(tmp_path, method, r):
     """Friction has a history: lam_t, the last converged u and the obstacle's frame.
@@ -127,24 +145,12 @@ def test_a_resumed_frictional_run_repeats_the_uninterrupted_one(tmp_path, method
     """
     import dataclasses
 
-    from fenics_contact.runner import run_scene
-
     scene = load_scene(SCENES / "block_slide_friction.toml")
     scene = dataclasses.replace(
         scene, solver=dataclasses.replace(scene.solver, method=method, steps=10),
         contact=dataclasses.replace(scene.contact, r=r),
     )
-    full = run_scene(scene, tmp_path / "full", comm=MPI.COMM_SELF, pictures=False)
-
-    def stop(step):
-        if step.step == 6:
-            raise _Stop
-
-    with pytest.raises(_Stop):
-        run_scene(scene, tmp_path / "part", comm=MPI.COMM_SELF, pictures=False, on_step=stop)
-    resumed = run_scene(scene, tmp_path / "part", comm=MPI.COMM_SELF, pictures=False,
-                        resume=True)
-    assert full.path.converged and resumed.path.converged
+    full, resumed = _full_and_resumed(scene, tmp_path, stop_after=6)
     assert [s.step for s in resumed.path.steps] == list(range(1, 11))
     for a, b in zip(full.path.steps, resumed.path.steps, strict=True):
         assert (a.iterations, a.tangential_force, a.contact_force, a.stick_count) == (
@@ -161,20 +167,8 @@ def test_a_resumed_run_keeps_the_active_set_predictors_gaps(tmp_path):
     checkpoint the steps after the resume decided their set by the
     extrapolated lam + r g alone: 3 iterations instead of 1 at steps 3 and 4.)
     """
-    from fenics_contact.runner import run_scene
-
     scene = load_scene(SCENES / "hertz_cylinder.toml")
     assert scene.solver.predictor == "active-set"
-    full = run_scene(scene, tmp_path / "full", comm=MPI.COMM_SELF, pictures=False)
-
-    def stop(step):
-        if step.step == 2:
-            raise _Stop
-
-    with pytest.raises(_Stop):
-        run_scene(scene, tmp_path / "part", comm=MPI.COMM_SELF, pictures=False, on_step=stop)
-    resumed = run_scene(scene, tmp_path / "part", comm=MPI.COMM_SELF, pictures=False,
-                        resume=True)
-    assert full.path.converged and resumed.path.converged
+    full, resumed = _full_and_resumed(scene, tmp_path, stop_after=2)
     assert [s.iterations for s in full.path.steps] == [s.iterations for s in resumed.path.steps]
     assert np.array_equal(full.problem.u.x.array, resumed.problem.u.x.array)
