@@ -182,6 +182,7 @@ class Solid:
         self.u = fem.Function(self.V, name="displacement")
         self.prescribed = list(prescribed)
         self.bcs = self._dirichlet(self.prescribed)
+        self._plane_axes: tuple[fem.Function, fem.Function] | bool | None = False  # not yet found
         self._traction_constants = [
             (fem.Constant(domain, np.zeros(gdim)), np.asarray(t.value, float))
             for t in self.tractions
@@ -286,11 +287,11 @@ class Solid:
 
         Collective on first call (it finds the planes), cached after.
         """
-        if not hasattr(self, "_plane_axes"):
+        if self._plane_axes is False:
             from fenics_contact.model.friction import plane_axes, symmetry_planes
 
             self._plane_axes = plane_axes(self.V, symmetry_planes(self.domain, self.prescribed))
-        return self._plane_axes
+        return self._plane_axes  # type: ignore[return-value]
 
     def set_load(self, t: float) -> None:
         """Set every prescribed component and traction to its value at load factor t."""
