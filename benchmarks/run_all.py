@@ -72,6 +72,7 @@ def main() -> None:
         call([PYTHON, str(HERE / "performance" / "cost_of_contact.py")])
     if "predict" in parts:
         call([PYTHON, str(HERE / "performance" / "active_set_prediction.py")])
+        call([PYTHON, str(HERE / "performance" / "exact_contact_set.py")])
     if "compile" in parts:
         call([PYTHON, str(HERE / "performance" / "compile_cost.py")])
     if "first" in parts:

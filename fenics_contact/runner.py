@@ -89,6 +89,7 @@ def _summary(scene: Scene, record: RunRecord, used: dict[str, dict] | None = Non
         "quadrature": scene.contact.quadrature,
         "mu": scene.contact.mu,
         "predictor": scene.solver.predictor,
+        "contact_set": scene.solver.contact_set,
         "linear_solver": scene.solver.linear_solver,
         "forcing": scene.solver.forcing,
         "reuse_preconditioner": scene.solver.reuse_preconditioner,
@@ -311,6 +312,7 @@ def scene_strategy(scene: Scene, problem: ContactProblem,
             reuse_preconditioner=scene.solver.reuse_preconditioner,
         ),
         observer=on_residual, predictor=scene.solver.predictor,
+        contact_set=scene.solver.contact_set,
     )
 
 

@@ -262,10 +262,12 @@ def test_a_striker_pushed_through_the_target_in_one_step_is_refused_then_cut_bac
 
     shipped = Path(__file__).parents[1] / "scenes" / "block_on_block.toml"
     text = shipped.read_text().replace('"../meshes/', f'"{shipped.parents[1]}/meshes/')
-    # from the last state: the active-set default starts the touching face in contact,
-    # and that first iterate stays out of the target
+    # from the last state and with the sign rule: the active-set default starts the
+    # touching face in contact, and the exact contact set holds every node within the
+    # prescribed push on the target from the first iterate; both keep that iterate out
+    # of the target (one step, no cut-back), which this test is not about
     text = text.replace('value = ["free", -0.01]', 'value = ["free", -0.3]').replace(
-        "steps = 2", 'steps = 1\npredictor = "previous"')
+        "steps = 2", 'steps = 1\npredictor = "previous"\ncontact_set = "sign"')
     scene = tmp_path / "deep.toml"
     scene.write_text(text)
     outcome = run_scene(load_scene(scene), tmp_path / "out", comm=MPI.COMM_SELF, pictures=False)

@@ -167,7 +167,7 @@ def test_demo_scene_files_describe_the_demo_problems(tmp_path):
     from fenics_contact.solvers.stepping import solve_load_path
 
     text = (SCENES / "paper_ex2.toml").read_text().replace(
-        "[solver]", '[solver]\npredictor = "previous"'
+        "[solver]", '[solver]\npredictor = "previous"\ncontact_set = "sign"'
     )
     (tmp_path / "ex2.toml").write_text(text)
     outcome = run_scene(load_scene(tmp_path / "ex2.toml"), tmp_path, pictures=False)

@@ -23,9 +23,9 @@ ROOT = Path(__file__).resolve().parents[1]
 #: scene -> (text edits, Newton iterations per step, force per contact) measured serially.
 SERIAL = {
     "o_ring": ((("h_contact = 0.02, h_far = 0.08", "h_contact = 0.04, h_far = 0.1"),
-                ("steps = 10", "steps = 6")), [7, 5, 5, 5, 5, 5],
+                ("steps = 10", "steps = 6")), [5, 5, 5, 5, 5, 5],
                {"bottom": 1.8925285522677908, "top": 1.8925285522677908}),
-    "cylinder_between_plates": ((), [7, 3, 3],
+    "cylinder_between_plates": ((), [4, 3, 3],
                                 {"side": 0.029977813209185338, "floor": 0.5578941073920747,
                                  "press": 0.557802084694372}),
     "three_blocks_3d": ((), [3, 2],

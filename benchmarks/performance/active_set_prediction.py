@@ -9,7 +9,13 @@ scenes' solver settings. Predictors: ``previous`` (the last converged
 state), ``extrapolate`` (linear extrapolation of the last two) and
 ``active-set`` (extrapolation, and the first iteration's contact set chosen
 from the gaps' history; :class:`~fenics_contact.solvers.predictor.ActiveSetPredicted`).
-Reported per case and predictor: Newton iterations in total and per step,
+Each predictor runs with the sign rule for the contact set of every Newton
+step (the paper's GNRM), and the active-set predictor also with the exact
+set of each step's linear model (``contact_set = "exact"``,
+:class:`~fenics_contact.solvers.complementarity.ExactContactSet`; its
+back-substitutions are reported as columns); ``two-cylinders-mortar`` is the
+shipped mortar scene ``scenes/two_cylinders.toml``.
+Reported per case and variant: Newton iterations in total and per step,
 and the load path's wall time (median of the repeats, the predictors of a
 case run interleaved). The answer is checked to be the same: largest
 displacement difference against ``extrapolate``, relative to the largest
@@ -41,8 +47,12 @@ from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.stepping import solve_load_path
 
 ROOT = Path(__file__).resolve().parents[2]
-PREDICTORS = ("previous", "extrapolate", "active-set")
-TARGETS = {"hertz-medium": 12, "hertz-fine": 16, "two-cylinders": 22, "paper-ex2": 40}
+#: (load-step predictor, each Newton step's contact set) of the runs.
+VARIANTS = (("previous", "sign"), ("extrapolate", "sign"), ("active-set", "sign"),
+            ("active-set", "exact"))
+REFERENCE = ("extrapolate", "sign")
+TARGETS = {"hertz-medium": 12, "hertz-fine": 16, "two-cylinders": 22,
+           "two-cylinders-mortar": 22, "paper-ex2": 40}
 
 
 def hertz(h: float):
@@ -64,20 +74,25 @@ CASES = {
     "hertz-medium": hertz(0.008),
     "hertz-fine": hertz(0.004),
     "two-cylinders": shipped("two_cylinders_node_to_segment"),
+    "two-cylinders-mortar": shipped("two_cylinders"),
     "paper-ex2": shipped("paper_ex2"),
 }
 
 
-def run(case: str, predictor: str) -> tuple[dict, np.ndarray]:
+def run(case: str, variant: tuple[str, str]) -> tuple[dict, np.ndarray]:
     """One load path; its record and the final displacement array."""
+    predictor, contact_set = variant
     problem, settings, steps = CASES[case]()
-    strategy = make_strategy("gnrm", problem, settings, predictor=predictor)
+    strategy = make_strategy("gnrm", problem, settings, predictor=predictor,
+                             contact_set=contact_set)
     start = time.perf_counter()
     path = solve_load_path(strategy, steps)
     wall = time.perf_counter() - start
-    assert path.converged, (case, predictor, path.status)
+    assert path.converged, (case, variant, path.status)
+    exact = strategy.kernel.complementarity
     return {
-        "case": case, "predictor": predictor, "newton": path.iterations,
+        "case": case, "predictor": predictor, "contact_set": contact_set,
+        "columns": exact.columns if exact is not None else 0, "newton": path.iterations,
         "per_step": [s.iterations for s in path.steps],
         "active": [s.active_count for s in path.steps], "path_s": wall,
     }, problem.u.x.array.copy()
@@ -91,27 +106,27 @@ def main() -> None:
     args = parser.parse_args()
     records, rows = {}, []
     for case in CASES:
-        runs: dict[str, list[dict]] = {p: [] for p in PREDICTORS}
+        runs: dict[tuple[str, str], list[dict]] = {v: [] for v in VARIANTS}
         answers = {}
-        run(case, "extrapolate")  # warm-up: forms compiled
+        run(case, REFERENCE)  # warm-up: forms compiled
         for _ in range(args.repeats):
-            for predictor in PREDICTORS:
-                record, u = run(case, predictor)
-                runs[predictor].append(record)
-                answers[predictor] = u
-        scale = float(np.abs(answers["extrapolate"]).max())
-        for predictor in PREDICTORS:
-            first = runs[predictor][0]
-            assert all(r["per_step"] == first["per_step"] for r in runs[predictor])
-            diff = float(np.abs(answers[predictor] - answers["extrapolate"]).max()) / scale
-            record = {**first, "path_s": float(np.median([r["path_s"] for r in runs[predictor]])),
+            for variant in VARIANTS:
+                record, u = run(case, variant)
+                runs[variant].append(record)
+                answers[variant] = u
+        scale = float(np.abs(answers[REFERENCE]).max())
+        for variant in VARIANTS:
+            first = runs[variant][0]
+            assert all(r["per_step"] == first["per_step"] for r in runs[variant])
+            diff = float(np.abs(answers[variant] - answers[REFERENCE]).max()) / scale
+            record = {**first, "path_s": float(np.median([r["path_s"] for r in runs[variant]])),
                       "u_difference": diff, "target": TARGETS[case]}
-            records[f"{case}/{predictor}"] = record
-            rows.append((case, predictor, record["newton"],
-                         " ".join(map(str, record["per_step"])), record["path_s"], diff,
-                         TARGETS[case]))
-    header = ("case", "predictor", "Newton", "per step", "path s (median)",
-              "u difference", "target")
+            records[f"{case}/{'/'.join(variant)}"] = record
+            rows.append((case, *variant, record["newton"],
+                         " ".join(map(str, record["per_step"])), record["columns"],
+                         record["path_s"], diff, TARGETS[case]))
+    header = ("case", "predictor", "contact set", "Newton", "per step", "columns",
+              "path s (median)", "u difference", "target")
     table = harness.md_table(header, rows)
     harness.write("active_set_prediction",
                   {"machine": harness.machine(), "repeats": args.repeats, "runs": records},

@@ -38,14 +38,17 @@ from fenics_contact.solvers.newton import NewtonKernel
 from fenics_contact.solvers.stepping import solve_load_path
 
 SETTINGS = SolverSettings(atol=1e-8)
-#: The load-step predictors of the contact runs.
-CONTACT = ("active-set", "extrapolate", "previous")
+#: The contact runs: (load-step predictor, each Newton step's contact set).
+CONTACT = (("active-set", "exact"), ("active-set", "sign"), ("extrapolate", "sign"),
+           ("previous", "sign"))
 
 
-def contact_run(predictor: str) -> tuple[dict, ContactProblem]:
+def contact_run(variant: tuple[str, str]) -> tuple[dict, ContactProblem]:
     """Solve with contact; return the record and the solved problem."""
+    predictor, contact_set = variant
     problem = cases.build(CYLINDER, 1.0, relative=True, quadrature="nodal")
-    strategy = make_strategy("gnrm", problem, SETTINGS, predictor=predictor)
+    strategy = make_strategy("gnrm", problem, SETTINGS, predictor=predictor,
+                             contact_set=contact_set)
     kernel = strategy.kernel
     before = kernel.timings.snapshot()
     start = time.perf_counter()
@@ -54,7 +57,7 @@ def contact_run(predictor: str) -> tuple[dict, ContactProblem]:
     assert path.converged, path.status
     t = kernel.timings.since(before).to_dict()
     return {
-        "case": f"contact GNRM ({predictor})",
+        "case": f"contact GNRM ({predictor}, {contact_set} set)",
         "newton": path.iterations,
         "jacobians": t["jacobians"],
         "residuals": t["residuals"],
@@ -123,19 +126,20 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--out", type=Path, default=harness.OUT)
     args = parser.parse_args()
-    _, solved = contact_run("extrapolate")  # warm-up, and the final contact set
+    _, solved = contact_run(CONTACT[0])  # warm-up, and the final contact set
     equivalent = DirichletEquivalent(solved)
     equivalent.run()
-    runs: dict[str, list[dict]] = {p: [] for p in (*CONTACT, "dirichlet")}
+    runs: dict[str, list[dict]] = {"/".join(v): [] for v in CONTACT}
+    runs["dirichlet"] = []
     for _ in range(args.repeats):  # interleaved: the same machine load for all of them
-        for predictor in CONTACT:
-            runs[predictor].append(contact_run(predictor)[0])
+        for variant in CONTACT:
+            runs["/".join(variant)].append(contact_run(variant)[0])
         runs["dirichlet"].append(equivalent.run())
     med = {k: harness.median_dict(v) for k, v in runs.items()}
     ratios = {
         k: float(np.median([c["per_step_s"] / d["per_step_s"]
                             for c, d in zip(runs[k], runs["dirichlet"], strict=True)]))
-        for k in CONTACT
+        for k in runs if k != "dirichlet"
     }
     rows = [
         (m["case"], m["newton"], m["jacobians"], m["residuals"], m["per_step_s"] * 1e3,

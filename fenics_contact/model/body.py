@@ -13,6 +13,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import basix
 import numpy as np
 import ufl
 import ufl.algorithms
@@ -204,6 +205,11 @@ class Solid:
                 b.tag, metadata=metadata
             )
         self._internal_form: fem.Form | None = None
+        # det F at the energy's degree-2 points: every load step checks it (compiled with
+        # the other forms, not inside the first step)
+        points, _ = basix.make_quadrature(domain.basix_cell(), 2)
+        self._det_expr = fem.Expression(ufl.det(ufl.Identity(gdim) + ufl.grad(self.u)), points)
+        self._det_cells = np.arange(domain.topology.index_map(gdim).size_local, dtype=np.int32)
 
     # -- energy -------------------------------------------------------------------
     def strain_energy(self) -> ufl.Form:

@@ -149,6 +149,14 @@ class Contact:
         """(T, dg_t): the gdim x (d-1) tangent matrix and the slip increment (length)."""
         raise NotImplementedError
 
+    def may_close(self, gaps: np.ndarray) -> np.ndarray:
+        """Which open nodes a Newton step may set in contact (the exact contact set).
+
+        True where the Jacobian holds the node's gap derivative while it is
+        open (every node here). ``gaps``: the owned nodal gaps (length).
+        """
+        return np.ones(gaps.size, dtype=bool)
+
     def penetration(self) -> float | None:
         """Global depth inside the partner's actual surface when it differs from -min(g, 0)."""
         return None

@@ -337,6 +337,14 @@ class MortarContact(Contact):
         self.open_gap = fem.Constant(solid.domain, default_scalar_type(self.surface.h))
         return self.mortar.nodal_gap(X, X + solid.u, self.open_gap)
 
+    def may_close(self, gaps: np.ndarray) -> np.ndarray:
+        """3D: only engaged nodes (G <= 1e-3 h) carry dG/du while open; 2D: every node."""
+        if self.gdim != 3:
+            return super().may_close(gaps)
+        from fenics_contact.model.mortar3d import ENGAGED
+
+        return gaps <= ENGAGED * self.mortar.open_gap
+
     def reported(self, values: np.ndarray) -> np.ndarray:
         """2D: the nodal force per tributary length of the multiplier field (stress).
 

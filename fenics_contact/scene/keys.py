@@ -254,6 +254,12 @@ KEY_DOCS: dict[str, dict[str, KeyDoc]] = {
                             "first iteration's contact set chosen from the gaps' history; from "
                             "the extrapolation alone; or from the last state.",
                             field="SolverSpec.predictor"),
+        "contact_set": KeyDoc('"exact" | "sign"', "The contact set of each Newton step "
+                              "(GNRM and auto, frictionless contacts, direct solver): the exact "
+                              "set of the step's linear model, found with the step's own "
+                              "factorisation; or the sign of lam + r g at the iterate (the "
+                              "paper's GNRM). The answer is the same.",
+                              field="SolverSpec.contact_set"),
         "linear_solver": KeyDoc('"direct" | "iterative"', "MUMPS, or GMRES with a Schur field "
                                 "split and algebraic multigrid (large 3D).",
                                 field="SolverSpec.linear_solver"),

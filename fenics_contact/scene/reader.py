@@ -29,7 +29,7 @@ KEYS: dict[str, set[str]] = {
                   "schedule", "tag", "x", "y", "z", "detect", "margin", "r", "relative",
                   "quadrature", "mu", "tangential_r_max"},
     "solver": {"method", "steps", "max_iterations", "atol", "rtol", "max_cutbacks", "predictor",
-               "linear_solver", "forcing", "reuse_preconditioner"},
+               "contact_set", "linear_solver", "forcing", "reuse_preconditioner"},
     "output": {"fields", "pictures"},
 }
 

@@ -43,6 +43,9 @@ Layout (units are the user's; be consistent)::
                  extrapolation of the last two, the first iteration's
                  contact set from the gaps' history) | "extrapolate" |
                  "previous",
+                 contact_set = "exact" (each Newton step takes the exact
+                 contact set of its linear model) | "sign" (the sign of
+                 lam + r g at the iterate),
                  linear_solver = "direct" (MUMPS) | "iterative" (GMRES,
                  Schur field split, algebraic multigrid; for large 3D),
                  forcing = "fixed" | "eisenstat-walker" and

@@ -13,6 +13,7 @@ from typing import Any
 from fenics_contact.model.materials import MATERIALS, elastic_constants_problem
 from fenics_contact.scene.reader import _array, _Reader
 from fenics_contact.scene.spec import (
+    CONTACT_SETS,
     GENERATOR_TAGS,
     METHODS,
     BodySpec,
@@ -205,6 +206,7 @@ def read_solver(reader: _Reader) -> SolverSpec:
         max_cutbacks=bounded("max_cutbacks", 4, 0, MAX_CUTBACKS),
         predictor=reader.choice("predictor", ("active-set", "extrapolate", "previous"),
                                 default="active-set"),
+        contact_set=reader.choice("contact_set", CONTACT_SETS, default="exact"),
         linear_solver=linear_solver,
         forcing=forcing,
         reuse_preconditioner=reuse,

@@ -17,6 +17,8 @@ from fenics_contact.solvers.diagnostics import SolverSettings
 
 #: Method names a scene may give: the strategy registry's.
 METHODS = tuple(STRATEGIES)
+#: How each Newton step chooses its contact set ([solver] contact_set).
+CONTACT_SETS = ("exact", "sign")
 #: Fields the XDMF output can hold.
 FIELDS = ("displacement", "contact_pressure", "gap", "active", "von_mises")
 #: Further fields of a frictional scene (tangential traction, slip increment,
@@ -151,6 +153,7 @@ class SolverSpec(SolverSettings):
     steps: int = 10
     max_cutbacks: int = 4
     predictor: str = "active-set"
+    contact_set: str = "exact"
     linear_solver: str = "direct"
     forcing: str = "fixed"
     reuse_preconditioner: str = "no"

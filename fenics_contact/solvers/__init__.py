@@ -7,6 +7,7 @@ from dataclasses import replace
 from fenics_contact.model.problem import ContactProblem
 from fenics_contact.solvers.auto import AutoStrategy
 from fenics_contact.solvers.base import Observer, SolveResult, Strategy
+from fenics_contact.solvers.complementarity import ExactContactSet
 from fenics_contact.solvers.diagnostics import SolverSettings
 from fenics_contact.solvers.gnrm import GeneralizedNewton
 from fenics_contact.solvers.linear import LinearSolverSettings
@@ -37,6 +38,10 @@ PAPER_NAMES = {
 #: extrapolated with the first iteration's contact set chosen from the gaps' history.
 PREDICTORS = ("previous", "extrapolate", "active-set")
 
+#: How each Newton step chooses its contact set: the sign of lam + r g at the
+#: iterate, or the exact set of the step's linear model.
+CONTACT_SETS = ("sign", "exact")
+
 
 def make_strategy(
     name: str,
@@ -46,6 +51,7 @@ def make_strategy(
     linear: LinearSolverSettings | None = None,
     observer: Observer | None = None,
     predictor: str = "previous",
+    contact_set: str = "sign",
 ) -> Strategy:
     """Build the strategy called ``name`` for ``problem``, fully configured.
 
@@ -61,6 +67,12 @@ def make_strategy(
             state; 'extrapolate' from the linear extrapolation of the last two;
             'active-set' also chooses the contact set of the first iteration
             (:class:`~fenics_contact.solvers.predictor.ActiveSetPredicted`).
+        contact_set: 'sign' takes each Newton step's contact set from the sign
+            of lam + r g at the iterate (the paper's GNRM); 'exact' solves the
+            step's linear complementarity problem with the step's
+            factorisation (:class:`~fenics_contact.solvers.complementarity.ExactContactSet`;
+            frictionless vertex-rule contacts of a multiplier kernel with a
+            direct solver, the sign rule elsewhere). The answer is the same.
     """
     try:
         cls = STRATEGIES[name]
@@ -70,12 +82,19 @@ def make_strategy(
         ) from None
     if predictor not in PREDICTORS:
         raise ValueError(f"Unknown predictor {predictor!r}; choose one of {', '.join(PREDICTORS)}.")
+    if contact_set not in CONTACT_SETS:
+        raise ValueError(f"Unknown contact_set {contact_set!r}; choose one of "
+                         f"{', '.join(CONTACT_SETS)}.")
     if problem.shared_contact_nodes:  # contacts meet at nodes: equal rows are possible
         linear = replace(linear or LinearSolverSettings(), null_pivots=True)
     strategy: Strategy = cls(problem, settings, linear=linear, observer=observer)
+    if contact_set == "exact":
+        exact = ExactContactSet(problem, strategy.kernel)  # type: ignore[attr-defined]
+        if exact.usable:
+            strategy.kernel.complementarity = exact  # type: ignore[attr-defined]
     if predictor == "active-set":
         return ActiveSetPredicted(strategy)
     return Extrapolated(strategy) if predictor == "extrapolate" else strategy
 
 
-__all__ = ["PREDICTORS", "STRATEGIES", "SolveResult", "Strategy", "make_strategy"]
+__all__ = ["CONTACT_SETS", "PREDICTORS", "STRATEGIES", "SolveResult", "Strategy", "make_strategy"]

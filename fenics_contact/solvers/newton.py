@@ -85,6 +85,9 @@ class NewtonKernel:
         self.residual_norm = np.inf
         self.forcing: EisenstatWalker | None = None
         self.lag: PreconditionerLag | None = None
+        #: The linear model's exact contact set at each step
+        #: (:class:`~fenics_contact.solvers.complementarity.ExactContactSet`); None: the sign rule.
+        self.complementarity = None
         self._built = False
         #: Krylov tolerance of each linear solve (iterative solver).
         self.krylov_rtols: list[float] = []
@@ -129,6 +132,8 @@ class NewtonKernel:
         """
         if self.forcing is not None:
             self.forcing.reset()
+        if self.complementarity is not None:
+            self.complementarity.begin()
         if self.lag is not None and self.linear.reuse_preconditioner == "step":
             self.lag.reset()
 
@@ -202,6 +207,8 @@ class NewtonKernel:
         solve (residual norm), which bounds the Eisenstat-Walker forcing term
         from below (an inexact solve need not go below it); 0 when unknown.
         """
+        if self.complementarity is not None and self.complementarity.prepare():
+            self.residual_norm = self._assemble_b()  # the candidates set in contact
         self._assemble_A()
         iterative = self.linear.kind != "direct"
         if self.forcing is not None:
@@ -219,6 +226,9 @@ class NewtonKernel:
             return False
         if not np.all(np.isfinite(self.dx.getArray(readonly=True))):
             return False
+        if self.complementarity is not None:
+            with stopwatch(self.timings, "solve_s"):
+                self.complementarity.correct()
         self.x.axpy(-damping, self.dx)
         self._push()
         return True
