@@ -379,9 +379,9 @@ class Solid:
             )
         if self._det_cells.size:
             values = self._det_expr.eval(self.domain, self._det_cells)
-            per_cell = values.reshape(self._det_cells.size, -1).min(axis=1)
-            worst = int(np.argmin(per_cell))
-            local = float(per_cell[worst])
+            flat = int(np.argmin(values))  # NaN first: an inside-out log J
+            worst = flat // (values.size // self._det_cells.size)
+            local = float(values.flat[flat])
             where = mesh.compute_midpoints(
                 self.domain, self.domain.topology.dim, self._det_cells[worst : worst + 1]
             )[0]
