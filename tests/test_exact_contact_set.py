@@ -79,6 +79,21 @@ def test_hertz_takes_one_newton_iteration_per_step_for_every_r() -> None:
 
 
 @pytest.mark.mpi
+def test_one_big_load_step_needs_the_set_of_its_linear_model_once() -> None:
+    """Hertz in one load step: 2 Newton iterations (the sign rule: 6), the same answer."""
+    answers = {}
+    for contact_set, iterations in (("sign", 6), ("exact", 2)):
+        problem = cases.build(CYLINDER, 1.0, relative=True, quadrature="nodal")
+        strategy = make_strategy("gnrm", problem, SolverSettings(atol=1e-8),
+                                 predictor="active-set", contact_set=contact_set)
+        path = solve_load_path(strategy, 1)
+        assert path.converged and path.iterations == iterations, (contact_set, path.iterations)
+        answers[contact_set] = problem.u.x.array.copy()
+    scale = np.abs(answers["sign"]).max()
+    assert np.abs(answers["exact"] - answers["sign"]).max() < 1e-9 * scale
+
+
+@pytest.mark.mpi
 def test_mortar_two_cylinders_scene_meets_its_iteration_target() -> None:
     """The shipped mortar scene: <= 22 Newton iterations over 10 steps, step 1 <= 4.
 
