@@ -37,6 +37,7 @@ from dolfinx.fem import petsc as fem_petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from fenics_contact.form_batches import form_together
 from fenics_contact.model.problem import VariationalSystem
 from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.newton import NewtonKernel
@@ -80,12 +81,11 @@ class CondensedKernel(NewtonKernel):
         comm = self.unknowns[0].function_space.mesh.comm
         self._comm = comm
         with stopwatch(self.timings, "compile_s"):
-            self.F_ext = fem.form(system.residuals, entity_maps=system.entity_maps,
-                              jit_options=system.jit_options)
             blocks = fem.forms.derivative_block(system.residuals, ext)
             blocks = [[_nonempty(f) for f in row] for row in blocks]
-            self.J_ext = fem.form(blocks, entity_maps=system.entity_maps,
-                              jit_options=system.jit_options)
+            self.F_ext, self.J_ext = form_together(
+                [list(system.residuals), blocks], entity_maps=system.entity_maps,
+                jit_options=system.jit_options)
             self.A_ext = fem_petsc.create_matrix(self.J_ext, kind="mpi")
             self.ext_spaces = [f.function_space for f in ext]
             self.b_ext = fem_petsc.create_vector(self.ext_spaces, kind="mpi")

@@ -21,6 +21,7 @@ from dolfinx.fem import petsc as fem_petsc
 
 from petsc4py import PETSc
 
+from fenics_contact.form_batches import form_together
 from fenics_contact.model.problem import VariationalSystem
 from fenics_contact.solvers.linear import (
     EisenstatWalker,
@@ -62,11 +63,10 @@ class NewtonKernel:
     ) -> None:
         self._start(system)
         with stopwatch(self.timings, "compile_s"):
-            self.F = fem.form(system.residuals, entity_maps=system.entity_maps,
-                              jit_options=system.jit_options)
             jacobian = fem.forms.derivative_block(system.residuals, system.unknowns)
-            self.J = fem.form(jacobian, entity_maps=system.entity_maps,
-                              jit_options=system.jit_options)
+            self.F, self.J = form_together(
+                [list(system.residuals), jacobian], entity_maps=system.entity_maps,
+                jit_options=system.jit_options)
             self.A = fem_petsc.create_matrix(self.J, kind="mpi")
             self._work_vectors()
         self._prefix = f"fc_{system.name}_{next(_prefix_counter)}_"
