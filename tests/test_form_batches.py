@@ -16,7 +16,7 @@ from dolfinx.fem import petsc as fem_petsc
 from mpi4py import MPI
 
 import fenics_contact  # noqa: F401  (before petsc4py)
-from fenics_contact.form_batches import form_together
+from fenics_contact.model.form_batches import form_together
 
 
 def _blocks():

@@ -21,7 +21,7 @@ from dolfinx.fem import petsc as fem_petsc
 
 from petsc4py import PETSc
 
-from fenics_contact.form_batches import form_together
+from fenics_contact.model.form_batches import form_together
 from fenics_contact.model.problem import VariationalSystem
 from fenics_contact.solvers.linear import (
     EisenstatWalker,
