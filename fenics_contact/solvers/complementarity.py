@@ -7,12 +7,16 @@ found one iteration late, and every such node costs an iteration.
 complementarity problem of the step's own linear model on the nodes that
 may change, with the factorisation the step has anyway:
 
-1. *candidates*: the nodes in contact at the iterate and the open nodes whose
-   gap is below the largest change of a nodal gap seen over the last step
-   (the band). Each open candidate is set in contact for the step by its
-   multiplier, lam = -r g - tiny: its force lam + r g stays zero, and the
-   Jacobian takes the contact branch, so the step holds every candidate on
-   its target (linearised gap zero). That is the step dx0.
+1. *candidates*: the nodes in contact at the iterate and the open nodes that
+   may close within the step: gap below a quarter of the node's gap change
+   over the last iteration, or below the prescribed displacement still to
+   be applied; never beyond a quarter of a facet (:data:`REACH`), at most
+   :data:`MAX_FORCED` (nearest first), and only where the contact says the
+   Jacobian holds the open node's gap derivative (``Contact.may_close``).
+   Each open candidate is set in contact for the step by its multiplier,
+   lam = -r g - margin: its force lam + r g stays zero, and the Jacobian
+   takes the contact branch, so the step holds every candidate on its
+   target (linearised gap zero). That is the step dx0.
 2. *release*: node j is opened in the linear model by shifting its gap row's
    right-hand side by w_j phi_j (w_j its lumped area), which gives it the
    linearised augmented gap r g_j = phi_j; the response is z_j = J^-1 e_j,
