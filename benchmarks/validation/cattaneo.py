@@ -212,6 +212,7 @@ def _solve_scene(
         solver.method, problem,
         SolverSettings(atol=solver.atol, rtol=solver.rtol, max_iterations=solver.max_iterations),
         linear=LinearSolverSettings(kind=solver.linear_solver), predictor=solver.predictor,
+        contact_set=solver.contact_set,
     )
     record = solve_load_path(
         strategy, solver.steps, max_cutbacks=solver.max_cutbacks,

@@ -26,10 +26,9 @@ import numpy as np
 from mpi4py import MPI
 
 import fenics_contact  # noqa: F401  (before dolfinx)
+from fenics_contact.runner import scene_strategy
 from fenics_contact.scene.build import build_mesh, build_two_body_problem, tagged_facets
 from fenics_contact.scene.schema import Scene, load_scene
-from fenics_contact.solvers import make_strategy
-from fenics_contact.solvers.predictor import Extrapolated
 from fenics_contact.solvers.stepping import solve_load_path
 
 #: Residuals below this are at round-off and left out of the order estimate.
@@ -51,10 +50,7 @@ def setup(scene: Scene):
     problem = build_two_body_problem(scene, body)
     top = tagged_facets(body, scene, "top", "top")
     knots = np.asarray(next(d for d in scene.dirichlet if d.path).path)
-    strategy = make_strategy(scene.solver.method, problem, scene.solver)
-    if scene.solver.predictor == "extrapolate":
-        strategy = Extrapolated(strategy)
-    return problem, top, knots, strategy
+    return problem, top, knots, scene_strategy(scene, problem)  # the scene's [solver]
 
 
 def main() -> None:

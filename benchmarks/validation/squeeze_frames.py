@@ -16,10 +16,9 @@ import numpy as np
 from mpi4py import MPI
 
 import fenics_contact  # noqa: F401  (before dolfinx)
+from fenics_contact.runner import scene_strategy
 from fenics_contact.scene.build import build_problem
 from fenics_contact.scene.schema import Scene
-from fenics_contact.solvers import make_strategy
-from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.stepping import solve_load_path
 
 
@@ -38,9 +37,7 @@ class Frame:
 def squeeze(scene: Scene) -> tuple[object, object, list[Frame]]:
     """Solve ``scene`` serially; return the problem, the run record and every step's frame."""
     problem = build_problem(scene, MPI.COMM_SELF)
-    strategy = make_strategy(scene.solver.method, problem, scene.solver,
-                             linear=LinearSolverSettings(kind=scene.solver.linear_solver),
-                             predictor=scene.solver.predictor)
+    strategy = scene_strategy(scene, problem)  # the scene's [solver], as `run` has it
     domain = problem.domain
     gdim = domain.geometry.dim
     cells = domain.geometry.dofmaps[0]
