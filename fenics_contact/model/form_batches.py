@@ -23,6 +23,9 @@ import ffcx.codegeneration.jit
 import ufl
 from dolfinx import default_scalar_type, fem
 
+#: Seconds a process waits for another one that compiles the same module.
+WAIT_S = 600
+
 
 def _flat(forms: Any) -> Iterator[ufl.Form]:
     if isinstance(forms, ufl.Form):
@@ -64,7 +67,11 @@ def form_together(forms: Any, *, entity_maps=None, jit_options: dict | None = No
         return fem.form(forms, entity_maps=entity_maps, jit_options=jit_options)
     comm = flat[0].ufl_domain().ufl_cargo().comm
     options = ffcx.get_options({"scalar_type": default_scalar_type})
-    compiled, module, code = _compile(comm, flat, options, dolfinx.jit.get_options(jit_options))
+    jit = dolfinx.jit.get_options(jit_options)
+    # another process compiling the same module is waited for (a batch compiles for longer
+    # than one form: DOLFINx's default wait of 10 s would fail a second run started meanwhile)
+    jit["timeout"] = max(int(jit.get("timeout", 10)), WAIT_S)
+    compiled, module, code = _compile(comm, flat, options, jit)
     ready = {id(f): (c, module, code) for f, c in zip(flat, compiled, strict=True)}
     original = dolfinx.jit.ffcx_jit
 
