@@ -81,7 +81,6 @@ class ExactContactSet:
     """
 
     def __init__(self, problem, kernel) -> None:
-        self.problem = problem
         self.kernel = kernel
         self.comm = problem.comm
         self.contacts = [c for c in problem.contacts
