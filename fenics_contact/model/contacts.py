@@ -92,14 +92,11 @@ class Contact:
         self.gap = self._bind_partner(solid)
         self.set_r(self.settings.r, relative=self.settings.relative)
         self.pressure = augmented_pressure(self.gap, self.lam, self.r)
-        self._gap_form = self.surface.nodal_form(self.gap)
-        self._pressure_form = self.surface.nodal_form(self.pressure)
-        self._force_form = fem.form(
-            -self.pressure * self.surface.ds, entity_maps=self.surface.entity_maps,
-            jit_options=self.jit_options)
-        self._multiplier_force_form = fem.form(
-            -self.lam * self.surface.ds, entity_maps=self.surface.entity_maps
-        )
+        nodal = self.surface.nodal_integrand
+        (self._gap_form, self._pressure_form, self._force_form,
+         self._multiplier_force_form) = self.surface.compile([
+            nodal(self.gap), nodal(self.pressure), -self.pressure * self.surface.ds,
+            -self.lam * self.surface.ds])
 
     def bind_friction(self, u_prev: fem.Function) -> None:
         """Add the Coulomb terms (after :meth:`bind`; u_prev: the last converged u)."""

@@ -94,43 +94,29 @@ class CoulombFriction:
         )
 
         k = gdim - 1
-        nodal = surface.nodal_form
-        self._tau_forms = [nodal(self.traction_t[i]) for i in range(k)]
-        self._pen_forms = [nodal(self.penalty_traction[i]) for i in range(k)]
-        self._slip_forms = [nodal(self.slip[i]) for i in range(k)]
-        self._y_forms = [nodal(self.trial_traction[i]) for i in range(k)]
-        self._rho_form = nodal(self.coulomb_radius)
-        self._global_forms = [
-            [nodal(-(self.tangents * self.traction_t)[i]) for i in range(gdim)],
-            [nodal((self.tangents * self.slip)[i]) for i in range(gdim)],
-        ]
+        nodal = surface.nodal_integrand
         force = self.tangents * self.traction_t
-        self._tforce_forms = [
-            fem.form(force[i] * surface.ds, entity_maps=surface.entity_maps,
-                     jit_options=contact.jit_options)
-            for i in range(gdim)
-        ]
-        self._tmag_form = fem.form(
-            ufl.sqrt(ufl.dot(self.traction_t, self.traction_t)) * surface.ds,
-            entity_maps=surface.entity_maps, jit_options=contact.jit_options,
-        )
         # The reported tangential traction of a multiplier strategy: the converged
         # multiplier lam_t (= tau at convergence), free of the round-off r eps g that
         # the Coulomb radius -mu min(lam + r g, 0) carries at a huge user r.
         multiplier = ufl.elem_mult(mask, lam_t)
-        self._multiplier_forms = [
-            [nodal(multiplier[i]) for i in range(k)],
-            [nodal(-(self.tangents * multiplier)[i]) for i in range(gdim)],
-        ]
-        self._multiplier_force_forms = [
-            fem.form((self.tangents * multiplier)[i] * surface.ds,
-                     entity_maps=surface.entity_maps, jit_options=contact.jit_options)
-            for i in range(gdim)
-        ]
-        self._multiplier_mag_form = fem.form(
+        (self._tau_forms, self._pen_forms, self._slip_forms, self._y_forms, self._rho_form,
+         self._global_forms, self._tforce_forms, self._tmag_form, self._multiplier_forms,
+         self._multiplier_force_forms, self._multiplier_mag_form) = surface.compile([
+            [nodal(self.traction_t[i]) for i in range(k)],
+            [nodal(self.penalty_traction[i]) for i in range(k)],
+            [nodal(self.slip[i]) for i in range(k)],
+            [nodal(self.trial_traction[i]) for i in range(k)],
+            nodal(self.coulomb_radius),
+            [[nodal(-(self.tangents * self.traction_t)[i]) for i in range(gdim)],
+             [nodal((self.tangents * self.slip)[i]) for i in range(gdim)]],
+            [force[i] * surface.ds for i in range(gdim)],
+            ufl.sqrt(ufl.dot(self.traction_t, self.traction_t)) * surface.ds,
+            [[nodal(multiplier[i]) for i in range(k)],
+             [nodal(-(self.tangents * multiplier)[i]) for i in range(gdim)]],
+            [(self.tangents * multiplier)[i] * surface.ds for i in range(gdim)],
             ufl.sqrt(ufl.dot(multiplier, multiplier)) * surface.ds,
-            entity_maps=surface.entity_maps, jit_options=contact.jit_options,
-        )
+        ])
         self.symmetry_constraints = self._constrain_symmetry_planes()
 
     def _constrain_symmetry_planes(self) -> int:
@@ -157,9 +143,11 @@ class CoulombFriction:
         n_owned = self.contact.Q.dofmap.index_map.size_local
         k = self.gdim - 1
         self.contact.refresh()
+        compiled = self.surface.compile([
+            [self.surface.nodal_integrand(self.tangents[i, j]) for j in range(k)]
+            for i in range(self.gdim)])
         frame = np.stack([
-            np.column_stack([self.surface.nodal(self.surface.nodal_form(self.tangents[i, j]))
-                             for j in range(k)])
+            np.column_stack([self.surface.nodal(compiled[i][j]) for j in range(k)])
             for i in range(self.gdim)
         ], axis=1)  # (owned nodes, gdim, d-1)
         count = 0
