@@ -12,8 +12,13 @@ again (median of ``--repeats``). Writes ``OUT/first_iteration.json`` and
 its value numbering (:mod:`fenics_contact.form_compiler` replaces it by a
 dictionary): the first start before and after, measured side by side.
 
+``--friction MU`` runs each scene with Coulomb friction of coefficient MU
+added to every pair that has none (a copy of the scene file, beside it):
+the frictional 3D two-body start that users meet.
+
 Run: ``python benchmarks/performance/first_iteration.py [--repeats 2]
-[--scenes two_hemispheres_3d,block_on_block_3d] [--scan-too] [--out results/bench]``.
+[--scenes two_hemispheres_3d,block_on_block_3d] [--friction 0.3] [--scan-too]
+[--out results/bench]``.
 """
 
 from __future__ import annotations
@@ -79,20 +84,46 @@ def once(scene: Path, cache: str, scan: bool = False) -> dict:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
+def with_friction(scene: Path, mu: float, folder: Path) -> Path:
+    """A copy of ``scene`` in ``folder`` whose pairs without ``mu`` get ``mu``.
+
+    The copy keeps the scene's relative paths (they are made absolute).
+    """
+    lines = []
+    for line in scene.read_text().splitlines():
+        if line.strip().startswith("file = \"../"):
+            line = line.replace('"../', f'"{scene.parent.parent}/')
+        lines.append(line)
+        if line.strip() == "[[pair]]":
+            lines.append(f"mu = {mu!r}")
+    text = "\n".join(lines) + "\n"
+    if text.count("\nmu = ") > text.count("[[pair]]"):
+        raise SystemExit(f"{scene.name}: a pair has its own mu; leave --friction out")
+    copy = folder / f"{scene.stem}_mu{mu:g}.toml"
+    copy.write_text(text)
+    return copy
+
+
 def main() -> None:
     """Cold and warm, scene after scene."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=2)
     parser.add_argument("--scenes", default=None, help="comma-separated names (default: all)")
     parser.add_argument("--out", type=Path, default=harness.OUT)
+    parser.add_argument("--friction", type=float, default=None, metavar="MU",
+                        help="add Coulomb friction MU to every pair (3D two-body with friction)")
     parser.add_argument("--scan-too", action="store_true",
                         help="also a cold run with FFCx's own node lookup, side by side")
     args = parser.parse_args()
     names = (args.scenes.split(",") if args.scenes
              else sorted(p.stem for p in (ROOT / "scenes").glob("*.toml")))
     runs = []
+    copies = tempfile.TemporaryDirectory()
     for name in names:
         scene = ROOT / "scenes" / f"{name}.toml"
+        if args.friction is not None:
+            scene = with_friction(scene, args.friction, Path(copies.name))
+            name = scene.stem
         with tempfile.TemporaryDirectory() as cache:
             cold = once(scene, cache)
             warm = [once(scene, cache) for _ in range(args.repeats)]

@@ -23,6 +23,8 @@ facet. The solver condenses the w_k onto u with the selection w_k = S_k u
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import numpy as np
 import scipy.sparse as sp
 import ufl
@@ -463,6 +465,12 @@ class NodeToSegmentContact(Contact):
             search and only facets facing it count (:mod:`.self_contact`).
         neighbourhood: radius of that neighbourhood in facet sizes.
     """
+
+    #: The pair's tangent kernels are large (MBs of C with friction in 3D): -O1
+    #: compiles the kernel's blocks in 5.9 s against 9.4 s at -O2 (frictional
+    #: hemispheres) and assembles as fast; it costs the bodies' own (small)
+    #: kernels about a tenth of their assembly speed (docs/benchmarks.md).
+    jit_options: ClassVar[dict] = {"cffi_extra_compile_args": ["-O1", "-g0"]}
 
     def __init__(
         self,

@@ -50,11 +50,23 @@ _prefix_counter = itertools.count()
 KEPT_ZEROS = 2.0
 
 
-def _nonempty(form: ufl.Form | None) -> ufl.Form | None:
-    """``None`` for a derivative block that vanishes identically."""
-    if form is None:
-        return None
-    return None if ufl.algorithms.expand_derivatives(form).empty() else form
+def _nonempty_blocks(residuals: list[ufl.Form], unknowns: list) -> list[list[ufl.Form | None]]:
+    """The derivative blocks d F_i / d w_j, ``None`` where F_i does not hold w_j.
+
+    Each residual is expanded once and the block is kept where its expanded
+    integrand holds the coefficient: n expansions of first derivatives,
+    rather than an expansion of each of the n x m second-derivative blocks
+    (seconds on a warm start for the large contact forms). Every residual of
+    the package depends on what it holds through values, not only through
+    conditions, so a held coefficient gives a non-empty block.
+    """
+    blocks = fem.forms.derivative_block(residuals, unknowns)
+    out = []
+    for residual, row in zip(residuals, blocks, strict=True):
+        held = set(ufl.algorithms.expand_derivatives(residual).coefficients())
+        out.append([f if f is not None and w in held else None
+                    for w, f in zip(unknowns, row, strict=True)])
+    return out
 
 
 def _owned(space: fem.FunctionSpace) -> int:
@@ -81,8 +93,7 @@ class CondensedKernel(NewtonKernel):
         comm = self.unknowns[0].function_space.mesh.comm
         self._comm = comm
         with stopwatch(self.timings, "compile_s"):
-            blocks = fem.forms.derivative_block(system.residuals, ext)
-            blocks = [[_nonempty(f) for f in row] for row in blocks]
+            blocks = _nonempty_blocks(list(system.residuals), ext)
             self.F_ext, self.J_ext = form_together(
                 [list(system.residuals), blocks], entity_maps=system.entity_maps,
                 jit_options=system.jit_options)
