@@ -13,10 +13,16 @@ may change, with the factorisation the step has anyway:
    be applied; never beyond a quarter of a facet (:data:`REACH`), at most
    :data:`MAX_FORCED` (nearest first), and only where the contact says the
    Jacobian holds the open node's gap derivative (``Contact.may_close``).
-   Each open candidate is set in contact for the step by its multiplier,
-   lam = -r g - margin: its force lam + r g stays zero, and the Jacobian
-   takes the contact branch, so the step holds every candidate on its
-   target (linearised gap zero). That is the step dx0.
+   Each open candidate is set in contact for the step by its multiplier:
+   the Jacobian is assembled at lam = -r g - margin, so that it takes the
+   contact branch, and the step starts from lam = -r g, where the residual
+   is that of the open branch with the new multiplier (the residual is
+   continuous across lam + r g = 0): the node puts no force on the
+   displacement rows on either side, and its own row, w (min(lam + r g, 0)
+   - lam) = -w lam in the open branch, changes with lam alone. So b is
+   patched on those rows, not assembled again (:meth:`ExactContactSet.settle`).
+   The step holds every candidate on its target (linearised gap zero).
+   That is the step dx0.
 2. *release*: node j is opened in the linear model by shifting its gap row's
    right-hand side by w_j phi_j (w_j its lumped area), which gives it the
    linearised augmented gap r g_j = phi_j; the response is z_j = J^-1 e_j,
@@ -92,6 +98,9 @@ class ExactContactSet:
             start += im.size_local * u.function_space.dofmap.index_map_bs
         self._offsets = [offsets.get(id(c.lam)) for c in self.contacts]
         self._last_gaps: list[np.ndarray] | None = None
+        #: The open candidates set in contact at this step, per contact: (positions in
+        #: the kernel's vectors, lumped areas, multipliers before, -r g).
+        self._settle: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
         #: Back-substitutions taken (columns), over the kernel's life.
         self.columns = 0
         self._step: _Candidates | None = None
@@ -108,7 +117,13 @@ class ExactContactSet:
 
     # -- before the Jacobian -------------------------------------------------------
     def prepare(self) -> bool:
-        """Choose the candidates and set the open ones in contact; True when b must be redone."""
+        """Choose the candidates and set the open ones in contact; True when any was set.
+
+        The multipliers of the ones set in contact are those the Jacobian is
+        assembled at (the kernel's x must take them); :meth:`settle` then
+        moves them to -r g and patches b.
+        """
+        self._settle = []
         if not self.usable:
             return False
         gaps = []
@@ -139,6 +154,9 @@ class ExactContactSet:
             if np.any(near):
                 # a margin well above the round-off of r g: the contact branch for sure
                 tiny = MARGIN * np.maximum(max(scale, 1e-6 * r * c.surface.h), r * np.abs(g[near]))
+                nodes = np.flatnonzero(near)
+                self._settle.append((offset + nodes, c.surface.lumped_area[nodes],
+                                     lam[nodes].copy(), -r * g[nodes]))
                 lam[near] = -r * g[near] - tiny
             changed |= bool(np.any(near))
             chosen = np.flatnonzero(active | near)
@@ -159,6 +177,25 @@ class ExactContactSet:
             forced=np.concatenate(self.comm.allgather(np.concatenate(forced))),
         )
         return changed
+
+    def settle(self) -> None:
+        """After the Jacobian: the candidates set in contact start the step at lam = -r g.
+
+        Their multiplier rows of b (w (min(lam + r g, 0) - lam): the open
+        branch's -w lam, which the contact branch equals there) change by
+        -w (lam_new - lam_old);
+        no other row holds a force from them, before or after. b was
+        assembled at lam_old by the loop's residual, and keeps its Dirichlet
+        rows and lifting.
+        """
+        if not self._settle:
+            return
+        x = self.kernel.x.getArray()
+        b = self.kernel.b.getArray()
+        for positions, weights, before, after in self._settle:
+            b[positions] -= weights * (after - before)
+            x[positions] = after
+        self._settle = []
 
     def _closest(self, gaps: list[np.ndarray], nears: list[np.ndarray]) -> list[np.ndarray]:
         """At most :data:`MAX_FORCED` open candidates over the ranks: those of smallest gap."""

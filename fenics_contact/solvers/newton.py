@@ -208,8 +208,10 @@ class NewtonKernel:
         from below (an inexact solve need not go below it); 0 when unknown.
         """
         if self.complementarity is not None and self.complementarity.prepare():
-            self.residual_norm = self._assemble_b()  # the candidates set in contact
+            self._pull()  # the candidates set in contact: x takes their multipliers
         self._assemble_A()
+        if self.complementarity is not None:
+            self.complementarity.settle()  # their rows of b, without assembling it again
         iterative = self.linear.kind != "direct"
         if self.forcing is not None:
             self.ksp.setTolerances(rtol=self.forcing(self.residual_norm, tolerance))
