@@ -302,6 +302,7 @@ class AutoStrategy(NewtonStrategy):
             if status is not None:
                 return status, steps
             start = kernel.x.copy()
+            step = None
             try:
                 if not kernel.newton_step(tolerance=monitor.tolerance()):
                     return monitor.fail(), steps
@@ -309,15 +310,21 @@ class AutoStrategy(NewtonStrategy):
                 reference = max(monitor.residuals[-a.nonmonotone :])
                 damping = 1.0
                 norm = kernel.assemble_residual()
+                # the step actually taken: x_new - x_start (the exact contact set moves the
+                # multipliers of its candidates before the step, so it is not -dx there)
+                step = kernel.x.copy()
+                step.axpy(-1.0, start)
                 while not norm <= (1.0 - a.armijo * damping) * reference:
                     if damping <= a.min_damping:
                         break
                     damping /= 2.0
-                    kernel.x.waxpy(-damping, kernel.dx, start)
+                    kernel.x.waxpy(damping, step, start)
                     self._push(kernel)
                     norm = kernel.assemble_residual()
             finally:
                 start.destroy()
+                if step is not None:
+                    step.destroy()
 
     def _penalty_start(self, settings: SolverSettings, tally: _Tally) -> bool:
         """Penalty solve at the current r, then lam = min(r g, 0); True on success."""
