@@ -77,6 +77,11 @@ def main() -> None:
         call([PYTHON, str(HERE / "performance" / "compile_cost.py")])
     if "first" in parts:
         call([PYTHON, str(HERE / "performance" / "first_iteration.py")])
+        # the 3D two-body scenes with friction on their pairs (issue 21's cold-start case)
+        call([PYTHON, str(HERE / "performance" / "first_iteration.py"), "--friction", "0.3",
+              "--scenes", "two_hemispheres_3d_node_to_segment,two_hemispheres_3d,"
+              "block_on_block_3d,three_blocks_3d",
+              "--out", str(ROOT / "results" / "bench" / "friction")])
     if "mortar" in parts:
         call([PYTHON, str(HERE / "performance" / "mortar_cost.py")])
         call([PYTHON, str(HERE / "performance" / "mortar_cost.py"), "--case", "hemispheres"])
