@@ -183,10 +183,9 @@ class ExactContactSet:
 
         Their multiplier rows of b (w (min(lam + r g, 0) - lam): the open
         branch's -w lam, which the contact branch equals there) change by
-        -w (lam_new - lam_old);
-        no other row holds a force from them, before or after. b was
-        assembled at lam_old by the loop's residual, and keeps its Dirichlet
-        rows and lifting.
+        -w (lam_new - lam_old); no other row holds a force from them, before
+        or after. b was assembled at lam_old by the loop's residual, and
+        keeps its Dirichlet rows and lifting.
         """
         if not self._settle:
             return
