@@ -13,7 +13,8 @@ The public API, in the order a run uses it::
 
     scene = load_scene("scenes/hertz_cylinder.toml")     # validated description
     problem = build_problem(scene)                       # mesh, spaces, UFL forms
-    strategy = make_strategy("gnrm", problem, SolverSettings(atol=1e-10))
+    strategy = scene_strategy(scene, problem)            # the scene's [solver]
+    # or: make_strategy("gnrm", problem, SolverSettings(atol=1e-10))
     record = solve_load_path(strategy, n_steps=4)        # a RunRecord
     # or all of it, with XDMF/JSON/pictures: run_scene(scene, Path("results/x"))
 
@@ -43,7 +44,7 @@ from fenics_contact.model.problem import (
     PrescribedDisplacement,
     SurfaceTraction,
 )
-from fenics_contact.runner import run_scene
+from fenics_contact.runner import run_scene, scene_strategy
 from fenics_contact.scene.build import build_problem
 from fenics_contact.scene.schema import Scene, SceneError, load_scene, scene_from_data
 from fenics_contact.solvers import STRATEGIES, make_strategy
@@ -76,5 +77,6 @@ __all__ = [
     "material",
     "run_scene",
     "scene_from_data",
+    "scene_strategy",
     "solve_load_path",
 ]

@@ -274,6 +274,7 @@ def run_scene(
         write_paraview_script(out / "solution.xdmf", scene.fields, scene.dimension)
 
     def finished(step: StepRecord) -> None:
+        step.reactions = problem.support_reactions()
         writer.write(step.load_factor)
         history = strategy.history if isinstance(strategy, Extrapolated) else []
         gaps = strategy.gap_history if isinstance(strategy, ActiveSetPredicted) else []

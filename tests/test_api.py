@@ -18,25 +18,30 @@ def test_unknown_name_is_an_attribute_error():
         fenics_contact.nonsense  # noqa: B018
 
 
-def test_readme_python_example_matches_hertz():
-    """load_scene, build_problem, make_strategy, solve_load_path on the shipped Hertz scene."""
+def test_readme_python_example_matches_hertz_and_the_command_line(tmp_path):
+    """load_scene, build_problem, scene_strategy, solve_load_path on the shipped Hertz scene.
+
+    The scene's own strategy: the iterations and the force of ``fenics-contact run``.
+    """
     from pathlib import Path
 
-    from fenics_contact import (
-        SolverSettings,
-        build_problem,
-        load_scene,
-        make_strategy,
-        solve_load_path,
-    )
+    from fenics_contact import build_problem, load_scene, run_scene, scene_strategy, solve_load_path
 
     scene = load_scene(Path(__file__).parents[1] / "scenes" / "hertz_cylinder.toml")
     problem = build_problem(scene)
-    strategy = make_strategy("gnrm", problem, SolverSettings(atol=1e-10))
+    strategy = scene_strategy(scene, problem)
     record = solve_load_path(strategy, scene.solver.steps)
-    assert record.converged and record.method == "gnrm"
+    assert record.converged and record.method == scene.solver.method
     assert record.steps_completed == scene.solver.steps
     assert record.max_penetration < 1e-12
     # the same geometry as the hertz_cylinder validation case: Hertz to mesh accuracy
     comparison = measure_hertz(problem, 1.0, 200.0, 0.3)
     assert abs(comparison.a_error) < 0.01 and abs(comparison.p0_error) < 0.01
+    # the command line's run of the scene: the same Newton iterations and force
+    cli = run_scene(scene, tmp_path / "out", pictures=False).path
+    assert [s.iterations for s in record.steps] == [s.iterations for s in cli.steps]
+    assert record.contact_force == pytest.approx(cli.contact_force, rel=1e-12)
+    # the support's reaction carries the contact force (a flat obstacle: normal = resultant)
+    (top,) = problem.support_reactions().values()
+    assert top[1] == pytest.approx(-record.contact_force, rel=1e-10)
+    assert abs(top[0]) < 1e-10 * record.contact_force

@@ -63,9 +63,9 @@ def test_xdmf_values_match_the_solution(tmp_path):
     state = problem.contact_state()
     q_coords = problem.nodal_coordinates()
     q_rows = [index[tuple(np.round(c[:2], 9))] for c in q_coords]
-    assert np.allclose(grid.point_data["contact_pressure"][q_rows], state.pressure, atol=1e-12)
+    assert np.allclose(grid.point_data["contact_pressure"][q_rows], -state.pressure, atol=1e-12)
     assert np.array_equal(grid.point_data["active"][q_rows] > 0.5, state.active)
-    assert grid.point_data["contact_pressure"].min() == pytest.approx(state.pressure.min())
+    assert grid.point_data["contact_pressure"].max() == pytest.approx(-state.pressure.min())
     # von Mises is positive wherever the bar is loaded
     assert grid.cell_data["von_mises"].max() > 1.0
 
@@ -107,9 +107,9 @@ def test_written_pressure_is_the_multiplier_at_huge_r(tmp_path):
         rows = [index[tuple(np.round(c[:2], 9))] for c in problem.nodal_coordinates()]
         pressure, active = pressure[rows], active[rows] > 0.5
         # the written field integrates to the reported force (lumped nodal areas)
-        force = -float(np.sum(pressure * problem.surface.lumped_area))
+        force = float(np.sum(pressure * problem.surface.lumped_area))
         assert force == pytest.approx(outcome.path.steps[-1].contact_force, rel=1e-12)
-        assert np.array_equal(active, pressure < 0.0)
+        assert np.array_equal(active, pressure > 0.0)
         fields[r] = pressure
     peak = float(np.max(np.abs(fields[1.0])))
     assert np.max(np.abs(fields[1e12] - fields[1.0])) <= 1e-8 * peak

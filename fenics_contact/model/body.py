@@ -47,10 +47,13 @@ class PrescribedDisplacement:
         facets: facet indices (local) where the condition holds.
         value: final displacement per component (length units); ``None``
             leaves that component free.
+        name: the support's name in the reports (the scene's tag); conditions
+            of one name make one support.
     """
 
     facets: np.ndarray
     value: tuple[float | None, ...]
+    name: str = ""
 
     def at(self, t: float) -> tuple[float | None, ...]:
         """Displacement per component at load factor t (None: free)."""
@@ -340,6 +343,22 @@ class Solid:
             dofs = dofs[dofs < n_owned * self.gdim]
             out[i] = vec.array[dofs].sum()
         return self.comm.allreduce(out, op=MPI.SUM)
+
+    def support_reactions(self) -> dict[str, list[float]]:
+        """The force each support exerts on the bodies, per component (force; per thickness in 2D).
+
+        One entry per support: the prescribed-displacement conditions of one
+        name (unnamed ones are ``dirichlet K``, K their position), over the
+        union of their facets, every component (a free component reads the
+        internal force there, zero unless other loads act on those nodes).
+        Summed over every support, the reactions balance the contact forces and
+        the tractions. Collective.
+        """
+        facets: dict[str, list[np.ndarray]] = {}
+        for k, condition in enumerate(self.prescribed):
+            facets.setdefault(condition.name or f"dirichlet {k + 1}", []).append(condition.facets)
+        return {name: [float(v) for v in self.reaction(np.unique(np.concatenate(parts)))]
+                for name, parts in facets.items()}
 
     def stresses(self) -> list[tuple[ufl.core.expr.Expr, np.ndarray | None]]:
         """Each body's Cauchy stress (3 x 3, UFL, with the moduli constants) and its cells."""

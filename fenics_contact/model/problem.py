@@ -389,6 +389,10 @@ class ContactProblem(FrictionalContacts):
         """Internal nodal force summed over the facets' nodes (see :meth:`Solid.reaction`)."""
         return self.solid.reaction(facets)
 
+    def support_reactions(self) -> dict[str, list[float]]:
+        """Each support's force on the bodies (see :meth:`Solid.support_reactions`)."""
+        return self.solid.support_reactions()
+
     def prescribed_mismatch(self) -> float:
         """Largest |u - u_D| over the prescribed components (length, global)."""
         return self.solid.prescribed_mismatch()

@@ -322,13 +322,19 @@ def camera_direction(plotter) -> np.ndarray:
 def oblique_direction(normal: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
     """(camera direction, up) for the whole deformed bodies: aside, a little from +n.
 
-    Without contact: from below and aside.
+    The screen's up is the global z axis (the bodies stand as they do in the
+    scene) unless the camera looks nearly along it; then the up of
+    :func:`screen_axes`. Without contact: from below and aside.
     """
+    z = np.eye(3)[2]
     if normal is None:
-        return np.array([1.0, -1.3, -0.8]) / np.linalg.norm([1.0, -1.3, -0.8]), np.eye(3)[2]
+        return np.array([1.0, -1.3, -0.8]) / np.linalg.norm([1.0, -1.3, -0.8]), z
     up, right = screen_axes(normal)
     direction = 0.5 * normal + 0.6 * right - 0.6 * up
-    return direction / np.linalg.norm(direction), up
+    direction /= np.linalg.norm(direction)
+    if abs(float(direction @ z)) < 0.9:
+        up = z
+    return direction, up
 
 
 #: Draws what surrounds the bodies into a panel: ``context(plotter, bounds)``.

@@ -27,7 +27,7 @@ Written by fenics-contact beside {index}. Usage:
 or, in the ParaView GUI, File > Load State... (Python state file) or
 View > Python Shell > Run Script. Without --step the last finished load step
 is shown; --png saves a screenshot and exits. The colour is the contact
-pressure -lam >= 0 (stress, zero off the contact surface).
+pressure p = -lam >= 0 (stress, zero off the contact surface).
 """
 
 import argparse
@@ -35,7 +35,6 @@ import os
 import sys
 
 from paraview.simple import (
-    Calculator,
     ColorBy,
     GetActiveViewOrCreate,
     GetAnimationScene,
@@ -73,15 +72,11 @@ if DISPLACEMENT is not None:
     shown = WarpByVector(Input=shown)
     shown.Vectors = ["POINTS", DISPLACEMENT]
     shown.ScaleFactor = 1.0
-if PRESSURE is not None:
-    shown = Calculator(Input=shown)
-    shown.ResultArrayName = "contact pressure -lam"
-    shown.Function = f"-{{PRESSURE}}"
 
 view = GetActiveViewOrCreate("RenderView")
 display = Show(shown, view)
 if PRESSURE is not None:
-    ColorBy(display, ("POINTS", "contact pressure -lam"))
+    ColorBy(display, ("POINTS", PRESSURE))
     display.RescaleTransferFunctionToDataRange(True, False)
     display.SetScalarBarVisibility(view, True)
 if DIMENSION == 2:

@@ -156,8 +156,6 @@ def draw_step(
     label, bar = field_labels(field, vector=values.ndim > 1)
     if values.ndim > 1:
         values = np.linalg.norm(values, axis=1)
-    if field == "contact_pressure":
-        values = -values
     data[label] = values
     flat = float(np.ptp(np.asarray(grid.points)[:, 2])) == 0.0
     pyvista.OFF_SCREEN = True
@@ -169,7 +167,7 @@ def draw_step(
         picture, plotter = _draw_plane(grid, style, label, bar, window)
     else:
         if "contact_pressure" in grid.point_data:
-            grid.point_data[PRESSURE] = -np.asarray(grid.point_data["contact_pressure"])
+            grid.point_data[PRESSURE] = np.asarray(grid.point_data["contact_pressure"])
         if "stick_slip" in grid.point_data:
             grid.point_data[STICK_SLIP] = np.asarray(grid.point_data["stick_slip"])
         if "body_id" in grid.cell_data:
@@ -203,7 +201,7 @@ def _draw_plane(grid, style: dict, label: str, bar: str, window: tuple[int, int]
     bounds = np.array(grid.bounds).reshape(3, 2).T
     zooms = []
     if "contact_pressure" in grid.point_data:
-        grid.point_data[PRESSURE] = -np.asarray(grid.point_data["contact_pressure"], float)
+        grid.point_data[PRESSURE] = np.asarray(grid.point_data["contact_pressure"], float)
         zooms = _contact_zones(grid, float(np.max(bounds[1] - bounds[0])))
     width = window[0] * (1 + len(zooms)) // (2 if zooms else 1)
     plotter = pyvista.Plotter(off_screen=True, window_size=(width, window[1]),

@@ -124,8 +124,9 @@ def finished_steps(index: Path) -> list[int]:
 class StepWriter:
     """Writes the chosen fields of every load step into its own closed HDF5 file.
 
-    Fields: displacement (P1 vector), contact_pressure, gap and active (P1
-    scalars, zero off the contact surface) and von_mises (cell-wise Cauchy
+    Fields: displacement (P1 vector), contact_pressure (p = -lam >= 0 in
+    compression, stress), gap and active (P1 scalars, zero off the contact
+    surface) and von_mises (cell-wise Cauchy
     von Mises stress). With friction also tangential_traction (the tangential
     traction the obstacle puts on the body, P1 vector, stress), slip (the
     slip increment of the load step relative to the obstacle, P1 vector,
@@ -218,7 +219,7 @@ class StepWriter:
         friction = any(name in FRICTION_FIELDS for name in self.fields)
         for contact in self.problem.contacts:
             state = contact.contact_state()
-            scalars["contact_pressure"].append(state.pressure)
+            scalars["contact_pressure"].append(-state.pressure)  # p = -lam >= 0
             scalars["gap"].append(state.gap)
             scalars["active"].append(state.active.astype(float))
             if not friction:

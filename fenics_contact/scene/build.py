@@ -308,8 +308,8 @@ def boundary_conditions(
                 f"{scene.path.name}: [[dirichlet]] {i + 1} selects no facet; widen its bounds."
             )
         prescribed.append(
-            PathDisplacement(facets, spec.value, path=spec.path) if spec.path
-            else PrescribedDisplacement(facets, spec.value)
+            PathDisplacement(facets, spec.value, str(spec.tag), path=spec.path) if spec.path
+            else PrescribedDisplacement(facets, spec.value, str(spec.tag))
         )
     tractions = [
         SurfaceTraction(

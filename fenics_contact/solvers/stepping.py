@@ -44,7 +44,9 @@ class StepRecord:
         cutbacks: how many times the increment was halved.
         active_count: nodes in contact at the end of the step.
         max_penetration: largest nodal penetration (length).
-        contact_force: total normal contact force (force, per thickness in 2D).
+        contact_force: total normal contact force, -int lam dA over every contact
+            (force, per thickness in 2D); on tilted normals a little more than the
+            resultant along the load (see ``reactions``).
         wall_s: wall-clock time of the step (seconds).
         min_det_F: smallest det F over the body at the end of the step (1
             undeformed; <= 0 means inverted elements).
@@ -57,6 +59,10 @@ class StepRecord:
         contacts: each contact's numbers by name (normal_force, active_count,
             max_penetration, tangential_force, stick_count, slip_count); the
             fields above are their sums (the largest penetration).
+        reactions: the force each support (prescribed displacement, by its
+            scene tag) exerts on the bodies at the end of the step, per
+            component (force, per thickness in 2D); filled by the scene
+            runner, empty otherwise.
     """
 
     step: int
@@ -78,6 +84,7 @@ class StepRecord:
     stick_count: int = 0
     slip_count: int = 0
     contacts: dict[str, dict] = field(default_factory=dict)
+    reactions: dict[str, list[float]] = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """Plain-data view for JSON."""
