@@ -44,8 +44,8 @@ def precompile(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> Precompiled:
     """Compile every form of ``scene`` that its run needs up to the first written step.
 
     Builds the problem and the strategy as ``fenics-contact run`` does, solves
-    the first load step, writes its fields and draws the run's pictures into a
-    temporary folder (removed afterwards).
+    the first load step, records its support reactions, writes its fields and
+    draws the run's pictures into a temporary folder (removed afterwards).
     """
     from fenics_contact.output.xdmf import StepWriter
     from fenics_contact.runner import draw_pictures, scene_strategy
@@ -60,10 +60,14 @@ def precompile(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> Precompiled:
         strategy = scene_strategy(scene, problem)
         record = start_record(strategy)
         writer = StepWriter(problem, out / "solution.xdmf", scene.fields)
+
+        def finished(step) -> None:  # what the run does after each step
+            step.reactions = problem.support_reactions()
+            writer.write(step.load_factor)
+
         try:
             solve_load_path(strategy, scene.solver.steps, max_cutbacks=scene.solver.max_cutbacks,
-                            on_step=lambda step: writer.write(step.load_factor),
-                            record=record, last_step=1)
+                            on_step=finished, record=record, last_step=1)
         finally:
             writer.close()
         draw_pictures(scene, problem, record, out)
