@@ -348,17 +348,32 @@ class Solid:
         """The force each support exerts on the bodies, per component (force; per thickness in 2D).
 
         One entry per support: the prescribed-displacement conditions of one
-        name (unnamed ones are ``dirichlet K``, K their position), over the
-        union of their facets, every component (a free component reads the
-        internal force there, zero unless other loads act on those nodes).
-        Summed over every support, the reactions balance the contact forces and
-        the tractions. Collective.
+        name (unnamed ones are ``dirichlet K``, K their position). A component
+        is the internal nodal force summed over the displacement components
+        the support prescribes (a free component reads 0), each counted once
+        per support; a component two supports prescribe at one node counts in
+        both. Over supports that share no prescribed component, the reactions
+        balance the contact forces and the tractions. Collective.
         """
-        facets: dict[str, list[np.ndarray]] = {}
+        if self._internal_form is None:
+            v = ufl.TestFunction(self.V)
+            self._internal_form = fem.form(ufl.derivative(self.strain_energy(), self.u, v))
+        vec = fem.assemble_vector(self._internal_form)
+        vec.scatter_reverse(la.InsertMode.add)
+        n_owned = self.V.dofmap.index_map.size_local * self.gdim
+        fdim = self.domain.topology.dim - 1
+        held: dict[str, list[list[np.ndarray]]] = {}
         for k, condition in enumerate(self.prescribed):
-            facets.setdefault(condition.name or f"dirichlet {k + 1}", []).append(condition.facets)
-        return {name: [float(v) for v in self.reaction(np.unique(np.concatenate(parts)))]
-                for name, parts in facets.items()}
+            parts = held.setdefault(condition.name or f"dirichlet {k + 1}",
+                                    [[] for _ in range(self.gdim)])
+            for i, value in enumerate(condition.at(1.0)):
+                if value is not None:
+                    dofs = fem.locate_dofs_topological(self.V.sub(i), fdim, condition.facets)
+                    parts[i].append(dofs[dofs < n_owned])
+        local = np.array([[vec.array[np.unique(np.concatenate(c))].sum() if c else 0.0
+                           for c in parts] for parts in held.values()]).reshape(-1, self.gdim)
+        total = self.comm.allreduce(local, op=MPI.SUM)
+        return {name: [float(v) for v in row] for name, row in zip(held, total, strict=True)}
 
     def stresses(self) -> list[tuple[ufl.core.expr.Expr, np.ndarray | None]]:
         """Each body's Cauchy stress (3 x 3, UFL, with the moduli constants) and its cells."""
