@@ -87,6 +87,9 @@ def main() -> None:
         call([PYTHON, str(HERE / "performance" / "mortar_cost.py"), "--case", "hemispheres"])
         call([PYTHON, str(HERE / "validation" / "mortar_patch.py")])
         call([PYTHON, str(HERE / "validation" / "mortar_hemispheres.py")])
+        call([PYTHON, str(HERE / "validation" / "mortar_hertz.py")])
+        call([PYTHON, str(HERE / "validation" / "mortar_hertz.py"), "--swap"])
+        call([PYTHON, str(HERE / "validation" / "striker_choice.py")])
     if "hertz3d" in parts:
         call([PYTHON, str(HERE / "validation" / "hertz3d.py")])
     for dofs, solver, ranks, repeats in LADDER:
