@@ -25,6 +25,7 @@ from fenics_contact.output.xdmf import StepWriter, finished_steps, step_files
 from fenics_contact.scene.build import build_problem
 from fenics_contact.scene.checks import warn_untagged_penetration
 from fenics_contact.scene.schema import Scene
+from fenics_contact.scene.striker_advice import advise_striker
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.base import SolveResult
 from fenics_contact.solvers.linear import LinearSolverSettings
@@ -298,6 +299,7 @@ def run_scene(
         writer.close()
     summary = _write_summary(comm, out, scene, path, used)
     warn_untagged_penetration(scene, problem)
+    advise_striker(scene, problem)
     if scene.pictures if pictures is None else pictures:
         draw_pictures(scene, problem, path, out)
     return RunOutcome(problem, path, summary, out)

@@ -1,0 +1,138 @@
+"""After a run: whether each two-body pair strikes with the surface its discretisation prefers.
+
+The striker carries one multiplier per node. A mortar pair striking with the
+finer surface over-determines the coarser target and its nodal pressures
+scatter about twice as much (``benchmarks/validation/striker_choice.py``);
+node-to-segment prefers the finer surface striking. The facet sizes compared
+are those where the pair touches at the end of the run: the striker facets
+with a node in contact, and the target facets within reach of them.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+from dolfinx import mesh
+from scipy.spatial import cKDTree
+
+from fenics_contact.model.mortar import MortarContact
+from fenics_contact.model.pairs import NodeToSegmentContact
+from fenics_contact.model.segments import node_blocks
+
+if TYPE_CHECKING:
+    from fenics_contact.model.problem import ContactProblem
+    from fenics_contact.scene.schema import Scene
+
+#: A size ratio beyond which the advice is given (striker / target, or its inverse).
+RATIO = 0.8
+
+
+@dataclass(frozen=True)
+class TouchingSizes:
+    """Mean facet sizes (mean edge length, length) where a pair touches."""
+
+    striker: float
+    target: float
+    striker_facets: int
+    target_facets: int
+
+
+def _corners(problem: ContactProblem, facets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Reference and current corner positions of this rank's owned ``facets``, (n, k, d)."""
+    domain = problem.domain
+    gdim, fdim = domain.geometry.dim, domain.topology.dim - 1
+    facets = np.asarray(facets, np.int32)
+    facets = facets[facets < domain.topology.index_map(fdim).size_local]
+    if facets.size == 0:
+        return np.zeros((0, gdim, gdim)), np.zeros((0, gdim, gdim))
+    nodes = mesh.entities_to_geometry(domain, fdim, facets)
+    X = domain.geometry.x[nodes][..., :gdim]
+    u = problem.u.x.array.reshape(-1, gdim)[node_blocks(problem.V)[nodes]]
+    return X, X + u
+
+
+def _edge_length(corners: np.ndarray) -> np.ndarray:
+    """Mean edge length of each facet (2D: its length)."""
+    k = corners.shape[1]
+    if k == 2:
+        return np.linalg.norm(corners[:, 1] - corners[:, 0], axis=1)
+    edges = [np.linalg.norm(corners[:, (i + 1) % k] - corners[:, i], axis=1) for i in range(k)]
+    return np.mean(edges, axis=0)
+
+
+def touching_sizes(problem: ContactProblem, contact) -> TouchingSizes | None:
+    """The facet sizes where ``contact`` (a two-body pair) touches; None where it does not.
+
+    Collective.
+    """
+    comm = problem.comm
+    gdim = problem.domain.geometry.dim
+    state = contact.contact_state()
+    pressed = np.concatenate(comm.allgather(contact.nodal_coordinates()[state.active][:, :gdim]))
+    if pressed.shape[0] == 0:
+        return None
+    X, x = _corners(problem, contact.facets)
+    scale = float(np.ptp(pressed, axis=0).max()) + 1.0
+    if X.shape[0]:
+        distance, _ = cKDTree(pressed).query(X.reshape(-1, gdim))
+        touching = (distance.reshape(X.shape[:2]) <= 1e-9 * scale).any(axis=1)
+    else:
+        touching = np.zeros(0, bool)
+    striker = np.concatenate(comm.allgather(_edge_length(x[touching])))
+    centres = np.concatenate(comm.allgather(x[touching].mean(axis=1)))
+    if striker.size == 0:
+        return None
+    _, y = _corners(problem, contact.target_facets)
+    sizes = _edge_length(y)
+    if y.shape[0]:
+        distance, _ = cKDTree(centres).query(y.mean(axis=1))
+        near = distance <= striker.max() + sizes
+    else:
+        near = np.zeros(0, bool)
+    target = np.concatenate(comm.allgather(sizes[near]))
+    if target.size == 0:
+        return None
+    return TouchingSizes(float(striker.mean()), float(target.mean()), striker.size, target.size)
+
+
+def advise_striker(scene: Scene, problem: ContactProblem) -> list[str]:
+    """Warn, per two-body pair, when the other surface should strike; return the advice given.
+
+    Mortar in 3D: the striker's facets where it touches finer than RATIO times
+    the target's (in 2D the coarser striker smooths the inside of the zone but
+    resolves its edge with fewer nodes: no advice). Node-to-segment: coarser
+    than the target's by as much. Self-contact pairs have one surface and get
+    none. Collective.
+    """
+    from fenics_contact.scene.checks import SceneWarning
+
+    advice = []
+    for contact in problem.contacts:
+        mortar = isinstance(contact, MortarContact)
+        if not (mortar or isinstance(contact, NodeToSegmentContact)) \
+                or getattr(contact, "self_contact", False):
+            continue
+        sizes = touching_sizes(problem, contact)
+        if sizes is None:
+            continue
+        ratio = sizes.striker / sizes.target
+        if mortar and problem.domain.geometry.dim == 3 and ratio < RATIO:
+            why = ("a mortar pair's nodal pressures are smoother with the coarser surface "
+                   "striking (about half the scatter)")
+        elif not mortar and ratio > 1.0 / RATIO:
+            why = "node-to-segment is more accurate with the finer surface striking"
+        else:
+            continue
+        text = (f"{scene.path.name}: [[pair]] {contact.name!r}: where it touches, the striker's "
+                f"facets are {sizes.striker:.3g} and the target's {sizes.target:.3g} "
+                f"(ratio {ratio:.2f}); {why}: swap striker and target "
+                "(docs/two_bodies.md, 'Which surface strikes').")
+        advice.append(text)
+        warnings.warn(SceneWarning(text), stacklevel=2)
+    return advice
+
+
+__all__ = ["RATIO", "TouchingSizes", "advise_striker", "touching_sizes"]

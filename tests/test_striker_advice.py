@@ -1,0 +1,63 @@
+"""The advice on which surface of a two-body pair strikes, from the facet sizes where it touches.
+
+The shipped sphere on a block (coarser hemisphere striking) gets none; the
+same scene with the roles swapped (the finer block striking) is told to swap
+them back. Node-to-segment is told the opposite on the two cylinders whose
+coarser arc strikes.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import warnings
+from pathlib import Path
+
+import pytest
+
+from fenics_contact import build_problem, load_scene, scene_strategy, solve_load_path
+from fenics_contact.scene.striker_advice import advise_striker, touching_sizes
+
+SCENES = Path(__file__).parents[1] / "scenes"
+
+
+def _solved(name: str, swap: bool, **mesh: float):
+    scene = load_scene(SCENES / name)
+    pair = scene.pairs[0]
+    if swap:
+        pair = dataclasses.replace(pair, striker=pair.target, target=pair.striker)
+    scene = dataclasses.replace(scene, pairs=(pair,), mesh=dataclasses.replace(
+        scene.mesh, parameters={**scene.mesh.parameters, **mesh}))
+    problem = build_problem(scene)
+    path = solve_load_path(scene_strategy(scene, problem), scene.solver.steps)
+    assert path.converged
+    return scene, problem
+
+
+@pytest.mark.parametrize("swap", [False, True])
+def test_mortar_3d_is_told_to_strike_with_the_coarser_surface(swap):
+    scene, problem = _solved("sphere_on_block_3d.toml", swap, h_sphere=0.04, h_block=0.03,
+                             fine_radius=0.25)
+    sizes = touching_sizes(problem, problem.contacts[0])
+    # where they touch, the hemisphere's facets are the coarser (about 0.04 against 0.03)
+    hemisphere, block = (sizes.target, sizes.striker) if swap else (sizes.striker, sizes.target)
+    assert hemisphere > 1.2 * block
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        advice = advise_striker(scene, problem)
+    if swap:
+        assert len(advice) == 1 and "swap striker and target" in advice[0]
+        assert "coarser surface striking" in advice[0]
+        assert any("Which surface strikes" in str(w.message) for w in caught)
+    else:
+        assert advice == []
+
+
+def test_node_to_segment_is_told_to_strike_with_the_finer_surface():
+    from fenics_contact.scene.checks import SceneWarning
+
+    scene, problem = _solved("two_cylinders_node_to_segment.toml", True, h_contact=0.02)
+    with pytest.warns(SceneWarning, match="finer surface striking"):
+        advice = advise_striker(scene, problem)
+    assert len(advice) == 1 and "ratio 1.3" in advice[0]  # the target's arc is 1.37 h
+    scene, problem = _solved("two_cylinders_node_to_segment.toml", False, h_contact=0.02)
+    assert advise_striker(scene, problem) == []
