@@ -71,6 +71,7 @@ def test_sliding_block_obeys_coulomb(gnrm_run):
         assert ratio <= 1.0 + 1e-12
     final = steps[-1]
     assert final.slip_count == final.active_count == 21
+    assert run.multiplier_dofs == 2 * 21  # lam and the tangential lam_t (2D: one each)
     assert ratios[-1] == pytest.approx(1.0, rel=1e-8, abs=0)
     # node by node: |tau| <= mu p where it sticks, = mu p where it slips
     state = problem.contact_state()

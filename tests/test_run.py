@@ -135,11 +135,15 @@ def test_failed_first_step_is_worded_truthfully(tmp_path, capsys, cutbacks, atte
     assert err[0].startswith("fenics-contact: load step 1 of 10 did not converge (max_iterations")
     assert err[0].endswith(
         f"after {attempts}); no load step finished, so {out} holds no solution.xdmf. To try: "
-        'method = "auto" (it lowers its working r and line-searches where GNRM cycles); more '
+        "a larger [solver] max_iterations (now 3: SUA counts every multiplier update as an "
+        "iteration and may need hundreds per load step); "
+        'method = "auto" (Newton on both unknowns; it lowers its working r and line-searches '
+        "where plain Newton cycles); more "
         "[solver] steps or max_cutbacks (smaller increments near the failure)."
     )
     summary = json.loads((out / "summary.json").read_text())
     assert summary["steps"][0]["cutbacks"] == cutbacks
+    assert summary["message"].startswith("load step 1: max_iterations at load factor")
 
 
 def test_failing_run_exits_nonzero_and_keeps_finished_steps(tmp_path, capsys):

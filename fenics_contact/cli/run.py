@@ -167,8 +167,15 @@ def _advice(scene: Scene, status: str) -> str:
     """What to try after a failed load step (nothing for a stop that is not the solver's)."""
     if status not in ("cycling", "diverged", "max_iterations", "inverted"):
         return ""
-    tips = [] if scene.solver.method == "auto" else [
-        'method = "auto" (it lowers its working r and line-searches where GNRM cycles)']
+    method = scene.solver.method
+    tips = []
+    if status == "max_iterations" and method in ("nua", "sua"):
+        tips.append(f"a larger [solver] max_iterations (now {scene.solver.max_iterations}: "
+                    f"{method.upper()} counts every multiplier update as an iteration and "
+                    "may need hundreds per load step)")
+    if method != "auto":
+        tips.append('method = "auto" (Newton on both unknowns; it lowers its working r '
+                    "and line-searches where plain Newton cycles)")
     tips.append("more [solver] steps or max_cutbacks (smaller increments near the failure)")
     return ". To try: " + "; ".join(tips) + "."
 

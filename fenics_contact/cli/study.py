@@ -106,7 +106,8 @@ def add_study_options(cmd: argparse.ArgumentParser, default_out: Path) -> None:
     """Methods, r values and stopping rules of a study (the paper's by default)."""
     cmd.add_argument(
         "--methods", type=methods, default=["penalty", "sua", "nua", "gnrm"],
-        help="comma-separated strategies: penalty,sua,nua,gnrm (default: all four)",
+        help="comma-separated strategies: penalty, sua, nua, gnrm, auto (default: the "
+             "paper's four, penalty,sua,nua,gnrm)",
     )
     cmd.add_argument(
         "--r", type=floats, default=[1.0, 10.0, 100.0, 1000.0, 10000.0],

@@ -84,8 +84,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "Pareto front marked). The project's own trade-off (Hertz, the Example 2 bar, the "
         "sliding block with friction, three meshes each) is benchmarks/research/tradeoff.py."
         " Each load step starts from the last converged state (predictor \"previous\", "
-        "whatever the scene says), so that every method starts alike: iteration counts "
-        "match `run` with predictor = \"previous\".",
+        "whatever the scene says), so that every method starts alike; its stopping "
+        "tolerance is its own (tighter than a scene's, to measure the error), so iteration "
+        "counts may exceed those of `run` with predictor = \"previous\" by one or two.",
     )
     cmd.add_argument("scenes", nargs="+", type=Path, help="scene files (.toml)")
     cmd.add_argument("--name", default=None,

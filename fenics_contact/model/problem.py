@@ -170,8 +170,10 @@ class ContactProblem(FrictionalContacts):
 
     @property
     def multiplier_dofs(self) -> int:
-        """Global number of normal multiplier degrees of freedom over the contacts."""
-        return sum(c.surface.num_dofs for c in self.contacts)
+        """Global number of multiplier unknowns: each contact's lam, and lam_t with friction."""
+        return sum(c.surface.num_dofs for c in self.contacts) + sum(
+            f.lam_t.function_space.dofmap.index_map.size_global
+            * f.lam_t.function_space.dofmap.index_map_bs for f in self._frictions())
 
     def multipliers(self) -> list[fem.Function]:
         """Every multiplier: each contact's lam, then each frictional contact's lam_t."""

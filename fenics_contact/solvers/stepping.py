@@ -62,7 +62,7 @@ class StepRecord:
         reactions: the force each support (prescribed displacement, by its
             scene tag) exerts on the bodies at the end of the step, per
             component (force, per thickness in 2D); filled by the scene
-            runner, empty otherwise.
+            runner for every finished step, empty for a failed one.
     """
 
     step: int
@@ -130,12 +130,13 @@ class RunRecord:
         r_absolute: r in stress per length.
         r_relative: r divided by E/h.
         displacement_dofs: global displacement unknowns.
-        multiplier_dofs: global multiplier unknowns.
+        multiplier_dofs: global multiplier unknowns (normal, and tangential with friction).
         processes: MPI ranks.
         wall_s: wall-clock time of the load path (seconds).
         error: relative L2 displacement error against a reference (NaN when none).
         switches: decisions an adaptive strategy took, in order.
-        message: what went wrong when status is ``error``.
+        message: what went wrong: the exception when status is ``error``, the failed
+            load step's message (``load step K: ...``) when a step failed.
     """
 
     status: str
@@ -361,6 +362,7 @@ def solve_load_path(
         run_start = time.perf_counter()
         if step.status != Status.CONVERGED:
             run.status = step.status
+            run.message = f"load step {step.step}: {step.message}"
             return run
         if on_step is not None:
             on_step(step)
