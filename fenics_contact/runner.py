@@ -196,7 +196,8 @@ def _replace_earlier_run(comm: MPI.Comm, out: Path) -> None:
             else f"{steps} load step{'s' if steps > 1 else ''}")
     print(f"fenics-contact: note: {out} held an earlier run ({done}); its results are replaced",
           file=sys.stderr, flush=True)
-    for name in RUN_FILES:
+    renders = [p.name for p in out.glob("render_step_*.png")]  # `fenics-contact render`'s
+    for name in (*RUN_FILES, *renders):
         try:
             (out / name).unlink(missing_ok=True)
         except OSError:  # unwritable: the run's first write names it
@@ -265,6 +266,7 @@ def run_scene(
             strategy.gap_history = saved.gaps
     record = start_record(strategy)
     record.steps = [StepRecord(**r) for r in saved.records] if saved is not None else []
+    record.wall_s = sum(s.wall_s for s in record.steps)  # a resumed run counts its earlier part
     first = saved.step + 1 if saved is not None else 1
     if not resume:
         _replace_earlier_run(comm, out)
@@ -290,8 +292,11 @@ def run_scene(
             strategy, scene.solver.steps, max_cutbacks=scene.solver.max_cutbacks,
             on_step=finished, record=record, first_step=first,
         )
-    except StopRequested:
+    except StopRequested as stop:
         record.status = "interrupted"
+        done = sum(s.status == "converged" for s in record.steps)
+        record.message = (f"{stop} after {done} finished load step{'s' if done != 1 else ''}; "
+                          "continue with --resume")
         if comm.rank == 0:
             write_json(out / "summary.json", _summary(scene, record, used))
         raise

@@ -147,6 +147,8 @@ def test_signal_stops_cleanly_with_one_line(scene, reference, tmp_path, signum):
     assert done["status"] == "interrupted"
     k = done["steps_completed"]
     assert 2 <= k < STEPS
+    assert done["message"] == (f"stopped by {signal.Signals(signum).name} after {k} finished "
+                               "load steps; continue with --resume")
     assert err[0] == (
         f"fenics-contact: stopped by {signum.name} after {k} of {STEPS} load steps; "
         f"steps 1-{k} are in {out}/solution.xdmf; resume with: "

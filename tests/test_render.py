@@ -127,3 +127,23 @@ def test_2d_render_of_a_wide_contact_zone_has_one_panel(run, tmp_path):
     """The bar of Example 2 presses along most of its length: no window."""
     _, picture = draw_step(run, path=tmp_path / "p.png")
     assert picture.panels == ["contact pressure -lam"]
+
+
+def test_a_damaged_step_file_is_named_and_a_run_without_pressure_draws_displacement(run, tmp_path):
+    """A truncated step file: one message naming it (exit 2); no pressure: the default field."""
+    import shutil
+
+    copy = tmp_path / "copy"
+    shutil.copytree(run, copy)
+    damaged = copy / "solution" / "step_0010.h5"
+    damaged.write_bytes(damaged.read_bytes()[:200])
+    with pytest.raises(ValueError, match=r"step_0010\.h5 cannot be read .*damaged"):
+        render_step(copy, step=10)
+    assert main(["render", str(copy), "--step", "10"]) == 2
+    # the same run as if it had written the displacement only
+    index = (copy / "solution" / "step_0009.xdmf")
+    text = index.read_text()
+    start = text.index('<Attribute Name="contact_pressure"')
+    index.write_text(text[:start] + text[text.index("</Attribute>", start) + 12:])
+    png = render_step(copy, step=9)
+    assert png.name == "render_step_0009_displacement.png" and png.is_file()

@@ -283,3 +283,17 @@ def test_an_absolute_tolerance_too_loose_for_the_forces_is_warned_about(tmp_path
     assert main(["run", str(SCENES / "paper_ex2.toml"), "--out", str(tmp_path / "stiff"),
                  "--no-pictures", "--quiet"]) == 0
     assert "atol" not in capsys.readouterr().err
+
+
+def test_a_new_run_removes_the_earlier_runs_pictures_and_renders_only(tmp_path, capsys):
+    """summary.json, deformed.png and `render`'s PNGs go; the user's own files stay."""
+    from fenics_contact.runner import _replace_earlier_run
+
+    out = tmp_path / "out"
+    out.mkdir()
+    for name in ("summary.json", "deformed.png", "render_step_0004_contact_pressure.png",
+                 "notes.txt", "my_render.png"):
+        (out / name).write_text("x")
+    _replace_earlier_run(MPI.COMM_SELF, out)
+    assert sorted(p.name for p in out.iterdir()) == ["my_render.png", "notes.txt"]
+    assert "held an earlier run" in capsys.readouterr().err

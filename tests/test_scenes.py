@@ -131,6 +131,20 @@ def test_unknown_geo_parameter_is_named(tmp_path):
         build_mesh(load_scene(scene_file))
 
 
+def test_a_geo_variable_of_another_parameter_name_is_pointed_to_that_name(tmp_path):
+    """R = {1.0, Name "Parameters/radius"}: the scene sets radius, and is told so for R."""
+    from fenics_contact.scene.build import build_mesh
+    from fenics_contact.scene.schema import SceneError, load_scene
+
+    shipped = Path(__file__).parents[1] / "scenes" / "hertz_cylinder.toml"
+    text = shipped.read_text().replace('"../meshes/', f'"{shipped.parents[1]}/meshes/')
+    scene_file = tmp_path / "bad.toml"
+    scene_file.write_text(text.replace("h_contact = 0.004", "h_contact = 0.004, R = 1.0"))
+    with pytest.raises(SceneError, match=r"'R' is the \.geo variable of the parameter "
+                                         r"'radius': set radius = "):
+        build_mesh(load_scene(scene_file))
+
+
 def test_geo_parameter_in_the_plain_form_is_named_with_the_form_to_use(tmp_path, capsys):
     """DefineConstant[h = 0.1] cannot be set from a scene: the message says how to declare it."""
     from fenics_contact.cli import main

@@ -25,9 +25,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     render.add_argument("out", type=Path, help="the run's output folder (its --out)")
     render.add_argument("--step", type=int, default=None,
                         help="load step, 1-based (default: the last finished one)")
-    render.add_argument("--field", default="contact_pressure",
+    render.add_argument("--field", default=None,
                         help="a field of the step file, e.g. displacement, gap, von_mises, "
-                        "stick_slip (default: contact_pressure)")
+                        "stick_slip (default: contact_pressure, or displacement where the "
+                        "run wrote no pressure)")
     render.add_argument("--png", type=Path, default=None,
                         help="the picture to write (default OUT/render_step_NNNN_FIELD.png)")
     render.set_defaults(func=_render)

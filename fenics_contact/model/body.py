@@ -129,7 +129,8 @@ def _check_bodies(domain: mesh.Mesh, cell_tags: mesh.MeshTags | None,
         return
     tags = [b.tag for b in bodies]
     if len(set(tags)) != len(tags):
-        raise ValueError(f"Body cell tags {tags} repeat; give each body its own tag.")
+        raise ValueError(f"Bodies {[b.name for b in bodies]} have the cell tags {tags}, which "
+                         "repeat; give each body its own tag.")
     present = set(np.unique(cell_tags.values).tolist())
     present = set().union(*domain.comm.allgather(present))
     for b in bodies:

@@ -97,7 +97,14 @@ def _read_step(source: Path):
     if kind not in _VTK_CELLS:
         raise ValueError(f"{source}: cells of type {kind!r} cannot be drawn here.")
     fields = {a.get("Name"): a for a in root.iter("Attribute")}
-    with h5py.File(source.with_suffix(".h5"), "r") as f:
+    try:
+        data = h5py.File(source.with_suffix(".h5"), "r")
+    except OSError as exc:
+        raise ValueError(
+            f"{source.with_suffix('.h5')} cannot be read ({exc}): the step file is damaged; "
+            "draw another --step, or run the scene again."
+        ) from None
+    with data as f:
         x = f["Mesh/mesh/geometry"][()]
         cells = f["Mesh/mesh/topology"][()].astype(np.int64)
         points = np.pad(x, ((0, 0), (0, 3 - x.shape[1])))
@@ -116,7 +123,7 @@ def _read_step(source: Path):
 
 
 def render_step(
-    out: Path, *, step: int | None = None, field: str = "contact_pressure",
+    out: Path, *, step: int | None = None, field: str | None = None,
     path: Path | None = None, window: tuple[int, int] = (1200, 800),
 ) -> Path:
     """Render ``field`` of load step ``step`` of the run in ``out`` on the deformed mesh.
@@ -125,6 +132,7 @@ def render_step(
         out: the run's output folder (``fenics-contact run ... --out OUT``).
         step: the load step (1-based; None: the last finished one).
         field: a point or cell field of the step file; vectors are drawn by magnitude.
+            None: contact_pressure, or displacement where the run wrote no pressure.
         path: the PNG to write (default ``OUT/render_step_NNNN_FIELD.png``).
         window: image size in pixels (2D; in 3D the height of each panel).
 
@@ -135,7 +143,7 @@ def render_step(
 
 
 def draw_step(
-    out: Path, *, step: int | None = None, field: str = "contact_pressure",
+    out: Path, *, step: int | None = None, field: str | None = None,
     path: Path | None = None, window: tuple[int, int] = (1200, 800),
 ) -> tuple[Path, Picture]:
     """:func:`render_step`, also returning what the picture shows (its panels and cameras)."""
@@ -144,6 +152,8 @@ def draw_step(
     source, chosen = _step_file(out, step)
     grid = _read_step(source)
     names = sorted(set(grid.point_data) | set(grid.cell_data))
+    if field is None:
+        field = next((f for f in ("contact_pressure", "displacement") if f in names), names[0])
     if field not in names:
         raise ValueError(
             f"Field {field!r} is not in step {chosen} of {out}; available: {', '.join(names)}."

@@ -8,6 +8,7 @@ themselves are the ``meshes/*.geo`` files, the only description of each.
 
 from __future__ import annotations
 
+import re
 import signal
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -88,6 +89,15 @@ def open_geo(gmsh: Any, path: Path | str, parameters: dict[str, float]) -> None:
         unknown = sorted(set(parameters) - declared)
         if unknown:
             first = unknown[0]
+            # a variable whose parameter has another name: R = {1, Name "Parameters/radius"}
+            named = dict(re.findall(r"(\w+)\s*=\s*\{[^}]*Name\s*\"Parameters/(\w+)\"",
+                                    Path(path).read_text(errors="replace")))
+            renamed = [f"{k!r} is the .geo variable of the parameter {named[k]!r}: set "
+                       f"{named[k]} = ..." for k in unknown if k in named and named[k] != k]
+            if renamed:
+                raise ValueError(f"{Path(path).name} declares no parameter "
+                                 f"{', '.join(map(repr, unknown))}; " + "; ".join(renamed)
+                                 + f" (it declares: {', '.join(sorted(declared))}).")
             raise ValueError(
                 f"{Path(path).name} declares no parameter {', '.join(map(repr, unknown))}; "
                 f"it declares: {', '.join(sorted(declared)) or 'none'}. A parameter the scene "

@@ -41,9 +41,11 @@ class _Reader:
         self.path = path
         self.section = section
         self.table = table
+        #: Which entry of an array of tables, after the section in messages (e.g. " 'upper'").
+        self.entry = ""
 
     def where(self, key: str) -> str:
-        return f"{self.path.name}: [{self.section}] {key}"
+        return f"{self.path.name}: [{self.section}]{self.entry} {key}"
 
     def fail(self, key: str, message: str) -> SceneError:
         return SceneError(f"{self.where(key)} = {self.table.get(key)!r}: {message}")

@@ -145,6 +145,8 @@ def scene_from_data(data: dict[str, Any], path: Path | str) -> Scene:
     _check_finite(path, data)
     head = _table(path, data, "scene")
     dimension = head.table.get("dimension")
+    if dimension is None:
+        raise SceneError(f"{path.name}: [scene] needs 'dimension': 2 (plane strain) or 3.")
     if dimension not in (2, 3):
         raise SceneError(
             f"{path.name}: [scene] dimension = {dimension!r}: use 2 (plane strain) or 3."

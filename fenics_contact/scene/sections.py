@@ -53,13 +53,15 @@ def read_mesh(path: Path, reader: _Reader, dimension: int) -> MeshSpec:
     ):
         raise reader.fail("parameters", "must be a table of numbers, e.g. { h_contact = 0.004 }.")
     if "file" in t:
-        file = Path(str(t["file"]))
-        if not file.is_absolute():
-            file = (path.parent / file).resolve()
-            if not file.exists():
-                file = Path(str(t["file"])).resolve()
+        given = Path(str(t["file"]))
+        file = given
+        if not given.is_absolute():
+            file = (path.parent / given).resolve()
+            if not file.exists() and given.resolve().exists():
+                file = given.resolve()  # relative to the working directory
         if not file.exists():
-            raise reader.fail("file", f"no such mesh file ({file}); check the path.")
+            where = "" if given.is_absolute() else " (a relative path is read beside the scene)"
+            raise reader.fail("file", f"no such mesh file ({file}){where}; check the path.")
         if file.suffix not in (".geo", ".msh"):
             raise reader.fail("file", "must be a gmsh .geo or .msh file.")
         _check_mesh_file(reader, file)
@@ -159,18 +161,25 @@ def read_bodies(path: Path, data: dict[str, Any]) -> tuple[BodySpec, ...]:
     """The [[body]] blocks: name, cell tag, law, E and nu; names must not repeat."""
     out = []
     for reader in _array(path, data, "body"):
+        name = str(reader.table.get("name", f"body{len(out) + 1}"))
+        reader.entry = f" {name!r}"  # messages name the body: [[body]] 'upper' nu = ...
         law = reader.choice("law", tuple(sorted(MATERIALS)))
         if "tag" not in reader.table:
-            raise SceneError(f"{path.name}: [[body]] needs 'tag', the cell tag of the body "
-                             "(a number or a physical surface/volume name).")
+            raise SceneError(f"{path.name}: [[body]] {name!r} needs 'tag', the cell tag of the "
+                             "body (a number or a physical surface/volume name).")
         E, nu = elastic_constants(reader)
-        out.append(BodySpec(
-            name=str(reader.table.get("name", f"body{len(out) + 1}")),
-            tag=reader.tag("tag"), law=law, E=E, nu=nu,
-        ))
+        out.append(BodySpec(name=name, tag=reader.tag("tag"), law=law, E=E, nu=nu))
     names = [b.name for b in out]
     if len(set(names)) != len(names):
         raise SceneError(f"{path.name}: [[body]] names {names} repeat; name each body once.")
+    seen: dict[object, str] = {}
+    for b in out:
+        if b.tag in seen:
+            raise SceneError(
+                f"{path.name}: [[body]] {seen[b.tag]!r} and {b.name!r} have the same tag = "
+                f"{b.tag!r}; each body is the cells of its own tag (a physical "
+                "surface/volume of the mesh).")
+        seen[b.tag] = b.name
     return tuple(out)
 
 
