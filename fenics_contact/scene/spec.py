@@ -86,7 +86,7 @@ class PairSpec:
     self_contact: bool = False
     #: Radius of each node's excluded neighbourhood along the surface (facet sizes).
     neighbourhood: float = 3.0
-    #: "node-to-segment" (one pass, the default) or "mortar" (2D).
+    #: "node-to-segment" (one pass, the default) or "mortar" (segment to segment, 2D and 3D).
     discretisation: str = "node-to-segment"
 
 
