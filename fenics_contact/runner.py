@@ -20,7 +20,7 @@ from fenics_contact.output.checkpoint import (
 )
 from fenics_contact.output.folders import agree, write_failure
 from fenics_contact.output.io import write_json
-from fenics_contact.output.paraview import write_paraview_script
+from fenics_contact.output.paraview import SCRIPT, write_paraview_script
 from fenics_contact.output.xdmf import StepWriter, finished_steps, step_files
 from fenics_contact.scene.build import build_problem
 from fenics_contact.scene.checks import warn_untagged_penetration
@@ -302,9 +302,16 @@ def run_scene(
         raise
     finally:
         writer.close()
+    if path.steps and path.steps[-1].status != "converged":
+        # the failed step's record holds the state the run stopped in (restored)
+        path.steps[-1].reactions = problem.support_reactions()
     summary = _write_summary(comm, out, scene, path, used)
     warn_untagged_penetration(scene, problem)
     advise_striker(scene, problem)
+    if not finished_steps(out / "solution.xdmf"):  # no step on disk: nothing to open
+        if comm.rank == 0:
+            (out / SCRIPT).unlink(missing_ok=True)
+        return RunOutcome(problem, path, summary, out)
     if scene.pictures if pictures is None else pictures:
         draw_pictures(scene, problem, path, out)
     return RunOutcome(problem, path, summary, out)

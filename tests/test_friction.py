@@ -241,6 +241,7 @@ def test_uncapped_tangential_r_makes_gnrm_stall_where_sliding_starts():
     assert run.steps_completed == PRESS_STEPS
     halved = [s for s in run.switches if "r_t halved" in s]
     assert len(halved) == 2 and "5e+03" in halved[-1]
+    assert all(f"(step {PRESS_STEPS + 1})" in s for s in halved)  # the step that cycled
     assert problem.tangential_cap == np.inf
 
 

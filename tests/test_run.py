@@ -144,6 +144,13 @@ def test_failed_first_step_is_worded_truthfully(tmp_path, capsys, cutbacks, atte
     summary = json.loads((out / "summary.json").read_text())
     assert summary["steps"][0]["cutbacks"] == cutbacks
     assert summary["message"].startswith("load step 1: max_iterations at load factor")
+    # the record holds the state the run stopped in (the last converged increment of
+    # step 1, if any), and no viewer files: no step is on disk
+    stopped = summary["steps"][0]
+    assert 0.0 <= stopped["load_factor"] < 0.1 and 0.5 < stopped["min_det_F"] <= 1.0
+    assert stopped["load_factor"] == 0.0 or cutbacks > 0
+    assert set(summary["steps"][0]["reactions"]) == {"top"}
+    assert not (out / "paraview_state.py").exists() and not (out / "deformed.png").exists()
 
 
 def test_failing_run_exits_nonzero_and_keeps_finished_steps(tmp_path, capsys):

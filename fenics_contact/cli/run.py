@@ -122,6 +122,8 @@ def _solve(
         bar.update(1)
         if not (quiet or terminal):
             newton = _count(record.iterations, "Newton iteration")
+            if record.cutbacks:
+                newton += f" ({_count(record.cutbacks, 'cut-back')})"
             print(f"{scene.name}: load step {record.step}/{steps} {record.status}, load factor "
                   f"{record.load_factor:.4g}, {newton}, contact force "
                   f"{record.contact_force:.6g}", file=sys.stderr, flush=True)

@@ -20,6 +20,7 @@ A path that ends ``inverted`` names the worst cell in ``StepRecord.message``.
 from __future__ import annotations
 
 import math
+import re
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
@@ -32,6 +33,11 @@ from fenics_contact.solvers.diagnostics import Status, admissibility
 @dataclass
 class StepRecord:
     """What one load step cost and where it ended.
+
+    A failed step's record holds the state the run stopped in: the last
+    converged one, at ``load_factor`` (its forces, counts, det F and
+    reactions); ``message`` names the load factor it failed at (det F is the
+    failed attempt's when it turned elements inside out).
 
     Attributes:
         step: 1-based step number.
@@ -134,7 +140,8 @@ class RunRecord:
         processes: MPI ranks.
         wall_s: wall-clock time of the load path (seconds).
         error: relative L2 displacement error against a reference (NaN when none).
-        switches: decisions an adaptive strategy took, in order.
+        switches: decisions an adaptive strategy took, in order, each with its load
+            step ("rescale r (step 3): ...").
         message: what went wrong: the exception when status is ``error``, the failed
             load step's message (``load step K: ...``) when a step failed.
     """
@@ -199,7 +206,8 @@ class RunRecord:
         d.update({k: getattr(self, k) for k in self._DERIVED})
         if math.isnan(self.error):
             d["error"] = None  # not measured (no reference)
-        d["switches"] = "; ".join(dict.fromkeys(s.split(":")[0] for s in self.switches))
+        d["switches"] = "; ".join(dict.fromkeys(
+            re.sub(r" \(step \d+\)$", "", s.split(":")[0]) for s in self.switches))
         return d
 
     def to_dict(self) -> dict[str, object]:
@@ -214,8 +222,14 @@ class RunRecord:
 PathResult = RunRecord
 
 
+def _at_step(switch: str, step: int) -> str:
+    """'rescale r: ...' -> 'rescale r (step 3): ...' (the kind first, as :meth:`row` reads it)."""
+    kind, colon, rest = switch.partition(":")
+    return f"{kind} (step {step}){colon}{rest}"
+
+
 def _absorb(record: StepRecord, result: SolveResult, run: RunRecord) -> None:
-    run.switches.extend(result.switches)
+    run.switches.extend(_at_step(s, record.step) for s in result.switches)
     record.iterations += result.iterations
     record.updates += result.updates
     record.linear_solves += result.linear_solves
@@ -340,6 +354,9 @@ def solve_load_path(
                 status = Status.INVERTED
             refused = refusal(strategy, result) if status is not Status.INVERTED else None
             problem.restore(saved)
+            if status is not Status.INVERTED:  # the record holds the state the run stops in
+                det = problem.min_det_F()
+                step.min_det_F, step.worst_cell = det.value, det.where
             halvings += 1
             if halvings > max_cutbacks or increment / 2 < smallest * (1 - 1e-12):
                 step.status = status.value
