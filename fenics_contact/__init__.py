@@ -36,8 +36,11 @@ except ImportError:  # DOLFINx installed otherwise (official images)
     pass
 
 from fenics_contact import form_compiler
+from fenics_contact.model.body import Body, Solid
+from fenics_contact.model.compositions import one_body_problem
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.materials import material
+from fenics_contact.model.obstacle_contact import ObstacleContact
 from fenics_contact.model.obstacles import RigidBall, RigidPlane
 from fenics_contact.model.problem import (
     ContactProblem,
@@ -58,15 +61,18 @@ __version__ = "0.1.0"
 
 __all__ = [
     "STRATEGIES",
+    "Body",
     "ContactProblem",
     "ContactSettings",
     "LinearSolverSettings",
+    "ObstacleContact",
     "PrescribedDisplacement",
     "RigidBall",
     "RigidPlane",
     "RunRecord",
     "Scene",
     "SceneError",
+    "Solid",
     "SolverSettings",
     "Status",
     "StepRecord",
@@ -75,6 +81,7 @@ __all__ = [
     "load_scene",
     "make_strategy",
     "material",
+    "one_body_problem",
     "run_scene",
     "scene_from_data",
     "scene_strategy",

@@ -55,6 +55,14 @@ class PrescribedDisplacement:
     value: tuple[float | None, ...]
     name: str = ""
 
+    def __post_init__(self) -> None:
+        if not isinstance(self.value, tuple | list | np.ndarray):
+            raise TypeError(f"value = {self.value!r}: give one entry per component, e.g. "
+                            "(0.0, -0.01), None for a free one: (None, -0.01).")
+        if not isinstance(self.facets, np.ndarray | list | tuple):
+            raise TypeError(f"facets: give an array of facet indices, not "
+                            f"{type(self.facets).__name__} (a MeshTags: tags.find(value)).")
+
     def at(self, t: float) -> tuple[float | None, ...]:
         """Displacement per component at load factor t (None: free)."""
         return tuple(None if v is None else t * float(v) for v in self.value)
@@ -80,7 +88,14 @@ class PathDisplacement(PrescribedDisplacement):
 
 @dataclass(frozen=True)
 class SurfaceTraction:
-    """Traction on facets per unit reference area, proportional to the load factor."""
+    """Traction on facets per unit reference area, proportional to the load factor.
+
+    Attributes:
+        facets: facet indices (local) it acts on.
+        value: the traction at load factor 1, a vector in the global axes (stress,
+            force per reference area; a dead load: it keeps its direction as the
+            surface turns), one entry per component; (0, -p) presses a top face down.
+    """
 
     facets: np.ndarray
     value: tuple[float, ...]
@@ -275,7 +290,12 @@ class Solid:
         fdim = self.domain.topology.dim - 1
         self._bc_constants: list[tuple[fem.Constant, PrescribedDisplacement, int]] = []
         bcs = []
-        for condition in prescribed:
+        for k, condition in enumerate(prescribed):
+            if self.comm.allreduce(np.asarray(condition.facets).size, op=MPI.SUM) == 0:
+                raise ValueError(
+                    f"Prescribed displacement {condition.name or k + 1!r} holds no facet; give "
+                    "the facets it acts on (mesh.locate_entities_boundary, or a facet tag)."
+                )
             components = condition.at(1.0)
             if len(components) != self.gdim:
                 raise ValueError(

@@ -64,7 +64,10 @@ def r_problem(r: float) -> str | None:
 
 
 def check_r(r: float) -> None:
-    """Raise ValueError when :func:`r_problem` finds r invalid."""
+    """Raise ValueError when :func:`r_problem` finds r invalid (TypeError: not a number)."""
+    if isinstance(r, bool) or not isinstance(r, int | float | np.floating | np.integer):
+        raise TypeError(f"The contact parameter r = {r!r} must be a number (stress per length, "
+                        "or a multiple of E/h with relative = True).")
     problem = r_problem(r)
     if problem is not None:
         raise ValueError(f"The contact parameter r = {r}: {problem}")

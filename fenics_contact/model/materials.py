@@ -181,7 +181,11 @@ MATERIALS: dict[str, type[Elastic]] = {
 
 
 def material(name: str, E: float, nu: float) -> Elastic:
-    """Build a law by name ('svk', 'neo-hookean' or 'linear')."""
+    """Build a law by name ('svk', 'neo-hookean' or 'linear'; any case).
+
+    E: Young's modulus (stress, any consistent units); nu: Poisson's ratio
+    (-1 < nu < 0.5). In 2D the laws are plane strain.
+    """
     try:
         cls = MATERIALS[name.lower()]
     except KeyError:

@@ -85,8 +85,10 @@ class RigidPlane(RigidObstacle):
 class RigidBall(RigidObstacle):
     """A rigid circle (2D) or sphere (3D) of given radius.
 
-    ``inside=False`` (default) keeps the body outside the ball:
-    g = |x - c| - R. ``inside=True`` keeps it inside a cradle: g = R - |x - c|.
+    ``centre`` (length, one entry per coordinate) and ``radius`` (length) place
+    it in the reference frame; a motion moves the centre. ``inside=False``
+    (default) keeps the body outside the ball: g = |x - c| - R. ``inside=True``
+    keeps it inside a cradle: g = R - |x - c|.
     """
 
     def __init__(

@@ -16,6 +16,9 @@ from fenics_contact.solvers.penalty import Penalty
 from fenics_contact.solvers.predictor import ActiveSetPredicted, Extrapolated
 from fenics_contact.solvers.sua import SimultaneousUzawa
 
+#: The solution strategies by name: penalty, simultaneous and nested Uzawa (sua, nua),
+#: the generalized Newton method on both unknowns (gnrm) and auto (GNRM at a working r
+#: in the measured window, with line search and fallbacks); see docs/formulation.md.
 STRATEGIES: dict[str, type] = {
     "penalty": Penalty,
     "sua": SimultaneousUzawa,
@@ -74,6 +77,9 @@ def make_strategy(
             frictionless vertex-rule contacts of a multiplier kernel with a
             direct solver, the sign rule elsewhere). The answer is the same.
     """
+    if not isinstance(settings, SolverSettings):
+        raise TypeError(f"settings = {settings!r}: give a SolverSettings (stopping rules), e.g. "
+                        "SolverSettings(atol=1e-10), or a scene's scene.solver.")
     try:
         cls = STRATEGIES[name]
     except KeyError:

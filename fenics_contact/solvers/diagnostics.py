@@ -41,7 +41,16 @@ import numpy as np
 
 
 class Status(StrEnum):
-    """Outcome of one nonlinear solve."""
+    """Outcome of one nonlinear solve.
+
+    ``converged``: the residual met the tolerance and the answer was admissible
+    (prescribed displacements, Signorini, Coulomb); ``cycling``: the contact set
+    (or stick/slip pattern) repeats without the residual falling; ``diverged``:
+    the residual grew beyond recovery or is not finite; ``max_iterations``: the
+    iteration limit was reached; ``inverted``: converged with elements turned
+    inside out (det F <= 0); ``error``: an exception (a run record's message says
+    which).
+    """
 
     CONVERGED = "converged"
     CYCLING = "cycling"

@@ -20,6 +20,7 @@ A path that ends ``inverted`` names the worst cell in ``StepRecord.message``.
 from __future__ import annotations
 
 import math
+import numbers
 import re
 import time
 from collections.abc import Callable
@@ -316,9 +317,20 @@ def solve_load_path(
     ``last_step`` ends the path after that step (a partial path: status
     "partial" when it converged up to there).
     """
+    if not hasattr(strategy, "problem") or not hasattr(strategy, "solve"):
+        raise TypeError(f"solve_load_path needs a strategy (make_strategy(method, problem, "
+                        f"settings)), got {type(strategy).__name__}.")
+    if isinstance(n_steps, bool) or not isinstance(n_steps, numbers.Integral):
+        raise TypeError(f"n_steps = {n_steps!r}: give a whole number of load steps >= 1.")
     if n_steps < 1:
         raise ValueError(f"The number of load steps must be >= 1, got {n_steps}.")
     problem = strategy.problem
+    if record is None and problem.load_factor >= 1.0 - 1e-14:
+        raise ValueError(
+            "Nothing to solve: the problem is at load factor 1, the end of its path (solved "
+            "before?). Build a new problem for a new run, or set_load(t) and strategy.solve() "
+            "for one more load."
+        )
     run = start_record(strategy) if record is None else record
     run_start = time.perf_counter()
     t = problem.load_factor
