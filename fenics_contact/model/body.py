@@ -345,6 +345,15 @@ class Solid:
         return self.comm.allreduce(local, op=MPI.MAX)
 
     # -- diagnostics --------------------------------------------------------------------
+    def _internal_force(self) -> la.Vector:
+        """The strain energy's nodal forces at the current u (owned and ghosts summed)."""
+        if self._internal_form is None:
+            v = ufl.TestFunction(self.V)
+            self._internal_form = fem.form(ufl.derivative(self.strain_energy(), self.u, v))
+        vec = fem.assemble_vector(self._internal_form)
+        vec.scatter_reverse(la.InsertMode.add)
+        return vec
+
     def reaction(self, facets: np.ndarray) -> np.ndarray:
         """Internal nodal force summed over the facets' nodes, per component (force).
 
@@ -352,11 +361,7 @@ class Solid:
         support exerts on the body (per unit thickness in 2D); tractions on
         the same facets are not included.
         """
-        if self._internal_form is None:
-            v = ufl.TestFunction(self.V)
-            self._internal_form = fem.form(ufl.derivative(self.strain_energy(), self.u, v))
-        vec = fem.assemble_vector(self._internal_form)
-        vec.scatter_reverse(la.InsertMode.add)
+        vec = self._internal_force()
         n_owned = self.V.dofmap.index_map.size_local
         out = np.zeros(self.gdim)
         for i in range(self.gdim):
@@ -376,11 +381,7 @@ class Solid:
         both. Over supports that share no prescribed component, the reactions
         balance the contact forces and the tractions. Collective.
         """
-        if self._internal_form is None:
-            v = ufl.TestFunction(self.V)
-            self._internal_form = fem.form(ufl.derivative(self.strain_energy(), self.u, v))
-        vec = fem.assemble_vector(self._internal_form)
-        vec.scatter_reverse(la.InsertMode.add)
+        vec = self._internal_force()
         n_owned = self.V.dofmap.index_map.size_local * self.gdim
         fdim = self.domain.topology.dim - 1
         held: dict[str, list[list[np.ndarray]]] = {}
