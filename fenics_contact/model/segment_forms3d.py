@@ -40,7 +40,6 @@ from dolfinx.fem import petsc as fem_petsc
 
 from mpi4py import MPI
 
-from fenics_contact.model.form_batches import form_together
 from fenics_contact.model.segments3d import REFERENCE, STRIKER_EDGES, Segments
 
 #: Columns of a corner's provenance row: kind (3), striker corner (3), target
@@ -122,17 +121,14 @@ class SegmentForms:
         self.fill(np.zeros((0, 6, 3)), np.zeros((0, 3, 15)))
 
     def compiled(self) -> dict[str, fem.Form]:
-        """The five forms compiled (once): four in one module at -O1, the Hessian alone.
-
-        The large Hessian kernel compiles at HESSIAN_OPT in its own module.
-        """
+        """The five forms compiled (once; the large Hessian kernel at HESSIAN_OPT)."""
         if self._compiled is None:
-            names = ("gap", "weight", "gap_tangent", "weight_tangent")
-            together = form_together([getattr(self, f"{name}_form") for name in names],
-                                     jit_options={"cffi_extra_compile_args": ["-O1", "-g0"]})
-            self._compiled = dict(zip(names, together, strict=True))
-            self._compiled["hessian"] = fem.form(self.hessian_form, jit_options={
-                "cffi_extra_compile_args": [HESSIAN_OPT, "-g0"]})
+            self._compiled = {
+                name: fem.form(getattr(self, f"{name}_form"), jit_options={
+                    "cffi_extra_compile_args": [HESSIAN_OPT if name == "hessian" else "-O1",
+                                                "-g0"]})
+                for name in ("gap", "weight", "gap_tangent", "weight_tangent", "hessian")
+            }
         return self._compiled
 
     def assemble_matrix(self, name: str) -> sp.csr_matrix:
