@@ -36,7 +36,13 @@ from fenics_contact.model.body import Body
 from fenics_contact.model.contact import ContactSettings, ContactSurface
 from fenics_contact.model.contacts import Contact
 from fenics_contact.model.friction import FrictionSettings, symmetric_frame
-from fenics_contact.model.search import TIE_TOL, Projection, SurfaceSearch, penetration_depth
+from fenics_contact.model.search import (
+    TIE_TOL,
+    Projection,
+    SurfaceSearch,
+    past_free_edge,
+    penetration_depth,
+)
 from fenics_contact.model.segments import node_blocks
 from fenics_contact.model.target_surface import REACH_FACETS, TargetSurface
 
@@ -368,6 +374,21 @@ class DeformablePair:
             self._prev_t = self.target_displacements(self._u_prev)
         current = (self.X_vertices + w_t)[self.facet_vertex]
         return penetration_depth(points, current, size=self._size, nearest=nearest)
+
+    def past_free_edge(self) -> np.ndarray:
+        """Owned striker nodes whose closest target point lies on a free edge, past it (bool).
+
+        Node-to-segment measures such a node's gap to the plane of the target's
+        last facet, extended past the surface's end (collective).
+        """
+        points = self.striker_positions()[: self.n_owned]
+        gathers = self.target.gathers
+        w_t, nearest = self._settled_search(points,
+                                            lambda current: _closest(current, points, self._size))
+        if self.target.gathers != gathers and self.w_prev is not None:
+            self._prev_t = self.target_displacements(self._u_prev)
+        current = (self.X_vertices + w_t)[self.facet_vertex]
+        return past_free_edge(points, current, size=self._size, nearest=nearest)
 
     def sources(self) -> list[np.ndarray]:
         """Global V block index that each owned W block selects, one array per vertex k.

@@ -284,6 +284,38 @@ def penetration_depth(points: np.ndarray, vertices: np.ndarray, candidates: int 
     points = np.asarray(points, float)
     if points.shape[0] == 0:
         return np.zeros(0)
+    nearest, idx, ties, on_surface = _closest_ties(points, vertices, candidates, size, nearest)
+    pseudo = np.einsum("ij,ijk->ik", ties.astype(float), facet_normals(vertices)[idx])
+    closest = _closest_points(points, vertices[nearest.facet])
+    behind = np.einsum("ij,ij->i", points - closest, pseudo) < 0.0
+    return np.where(behind & on_surface, nearest.distance, 0.0)
+
+
+def past_free_edge(points: np.ndarray, vertices: np.ndarray, candidates: int = 8,
+                   size: float | None = None, nearest: Projection | None = None) -> np.ndarray:
+    """Whether each point's closest point of the surface lies on a free edge, the point beyond.
+
+    A free edge bounds one facet of the surface only (the end of a polyline, the
+    rim of a patch); a point past it (by more than the tie tolerance) faces no
+    part of the surface. Arguments as :func:`penetration_depth`.
+    """
+    points = np.asarray(points, float)
+    if points.shape[0] == 0:
+        return np.zeros(0, bool)
+    nearest, _, _, on_surface = _closest_ties(points, vertices, candidates, size, nearest)
+    scale = SurfaceSearch(vertices, candidates, size=size).size
+    return ~on_surface & (nearest.overshoot > TIE_TOL * scale)
+
+
+def _closest_ties(points: np.ndarray, vertices: np.ndarray, candidates: int,
+                  size: float | None, nearest: Projection | None):
+    """(closest projection, candidate facets, ties to the closest distance, on the surface).
+
+    On the surface: the closest point inside its facet, or shared by several
+    facets. Past a free edge of the surface (the closest point on one facet
+    only, at its boundary) no side is defined: the body's other faces are
+    there, not this surface.
+    """
     search = SurfaceSearch(vertices, candidates, size=size)
     if nearest is None:
         nearest = search.closest(points)
@@ -293,10 +325,5 @@ def penetration_depth(points: np.ndarray, vertices: np.ndarray, candidates: int 
     idx[:, 0] = nearest.facet  # the closest facet is always among the candidates
     _, dist, _ = project(points, vertices[idx])
     ties = dist <= nearest.distance[:, None] + TIE_TOL * search.size
-    pseudo = np.einsum("ij,ijk->ik", ties.astype(float), facet_normals(vertices)[idx])
-    closest = _closest_points(points, vertices[nearest.facet])
-    behind = np.einsum("ij,ij->i", points - closest, pseudo) < 0.0
-    # past a free edge of the surface (the closest point on one facet only, at its
-    # boundary) no side is defined: the body's other faces are there, not this surface
     on_surface = (nearest.overshoot == 0.0) | (ties.sum(axis=1) > 1)
-    return np.where(behind & on_surface, nearest.distance, 0.0)
+    return nearest, idx, ties, on_surface

@@ -323,8 +323,8 @@ def oblique_direction(normal: np.ndarray | None) -> tuple[np.ndarray, np.ndarray
     """(camera direction, up) for the whole deformed bodies: aside, a little from +n.
 
     The screen's up is the global z axis (the bodies stand as they do in the
-    scene) unless the camera looks nearly along it; then the up of
-    :func:`screen_axes`. Without contact: from below and aside.
+    scene), the camera above them, unless it looks nearly along z; then the up
+    of :func:`screen_axes`. Without contact: from below and aside.
     """
     z = np.eye(3)[2]
     if normal is None:
@@ -334,6 +334,8 @@ def oblique_direction(normal: np.ndarray | None) -> tuple[np.ndarray, np.ndarray
     direction /= np.linalg.norm(direction)
     if abs(float(direction @ z)) < 0.9:
         up = z
+        if direction[2] < 0.0:  # seen from above, as the bodies stand
+            direction = direction * np.array([1.0, 1.0, -1.0])
     return direction, up
 
 
