@@ -575,7 +575,7 @@ def test_pair_facets_inside_the_mesh_are_refused(tmp_path):
 def test_floating_body_of_a_pair_is_named(tmp_path):
     text = BLOCKS.replace('[[dirichlet]]\ntag = "bottom"\nvalue = ["free", 0.0]\n', "")
     with pytest.raises(SceneError, match=r"\[\[body\]\] 'lower': no \[\[dirichlet\]\] condition "
-                       r"holds its rigid motions \(translation in y\), and contact holds nothing"):
+                       r"holds its rigid motions \(translation in y\), and its contacts do not"):
         _build(_blocks(tmp_path, text))
 
 

@@ -344,10 +344,12 @@ def check_bodies_held(
     name, motions = free[0]
     raise SceneError(
         f"{scene.path.name}: [[body]] {name!r}: no [[dirichlet]] condition holds "
-        f"its rigid motions ({'; '.join(motions)}), and contact holds nothing before it "
-        f"closes (nor along it: friction is not counted as a support). Fix: prescribe "
+        f"its rigid motions ({'; '.join(motions)}), and its contacts do not hold them at the "
+        f"start: one open, or touching with no pressure yet, holds nothing before the load "
+        f"presses it (nor along it: friction is not counted as a support). Fix: prescribe "
         f"components on a face of {name!r} (e.g. a support, a symmetry plane or a driven "
-        "face), or start it touching the parts that hold it."
+        "face: a prescribed displacement instead of a traction), or start it touching the "
+        "parts that hold it."
     )
 
 
