@@ -366,13 +366,7 @@ class DeformablePair:
         passed can lie inside the real surface while its gap to that plane is
         positive.
         """
-        points = self.striker_positions()[: self.n_owned]
-        gathers = self.target.gathers
-        w_t, nearest = self._settled_search(points,
-                                            lambda current: _closest(current, points, self._size))
-        if self.target.gathers != gathers and self.w_prev is not None:
-            self._prev_t = self.target_displacements(self._u_prev)
-        current = (self.X_vertices + w_t)[self.facet_vertex]
+        points, current, nearest = self._closest_on_surface()
         return penetration_depth(points, current, size=self._size, nearest=nearest)
 
     def past_free_edge(self) -> np.ndarray:
@@ -381,14 +375,22 @@ class DeformablePair:
         Node-to-segment measures such a node's gap to the plane of the target's
         last facet, extended past the surface's end (collective).
         """
+        points, current, nearest = self._closest_on_surface()
+        return past_free_edge(points, current, size=self._size, nearest=nearest)
+
+    def _closest_on_surface(self) -> tuple[np.ndarray, np.ndarray, Projection]:
+        """(owned striker positions, current target facet vertices, closest projections).
+
+        The closest point over the whole target surface, the kept facets settled
+        for it (collective; :meth:`_settled_search`).
+        """
         points = self.striker_positions()[: self.n_owned]
         gathers = self.target.gathers
         w_t, nearest = self._settled_search(points,
                                             lambda current: _closest(current, points, self._size))
         if self.target.gathers != gathers and self.w_prev is not None:
             self._prev_t = self.target_displacements(self._u_prev)
-        current = (self.X_vertices + w_t)[self.facet_vertex]
-        return past_free_edge(points, current, size=self._size, nearest=nearest)
+        return points, (self.X_vertices + w_t)[self.facet_vertex], nearest
 
     def sources(self) -> list[np.ndarray]:
         """Global V block index that each owned W block selects, one array per vertex k.
