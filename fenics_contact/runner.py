@@ -24,7 +24,6 @@ from fenics_contact.output.paraview import SCRIPT, write_paraview_script
 from fenics_contact.output.xdmf import StepWriter, finished_steps, step_files
 from fenics_contact.scene.build import build_problem
 from fenics_contact.scene.checks import warn_untagged_penetration
-from fenics_contact.scene.overhang import warn_overhanging_pairs
 from fenics_contact.scene.schema import Scene
 from fenics_contact.scene.striker_advice import advise_striker
 from fenics_contact.solvers import make_strategy
@@ -235,7 +234,7 @@ def _warn_loose_tolerance(scene: Scene, problem: ContactProblem) -> None:
 
 def run_scene(
     scene: Scene,
-    out: Path,
+    out: Path | str,
     *,
     comm: MPI.Comm = MPI.COMM_WORLD,
     on_step: Callable[[StepRecord], None] | None = None,
@@ -254,6 +253,7 @@ def run_scene(
     finished step); a checkpoint of another scene or process count raises
     :class:`~fenics_contact.output.checkpoint.CheckpointError`.
     """
+    out = Path(out)
     run_identity = identity(scene, comm.size)
     marker = read_latest(out / "checkpoint", run_identity) if resume else None  # before building
     problem = build_problem(scene, comm)
@@ -309,7 +309,6 @@ def run_scene(
     summary = _write_summary(comm, out, scene, path, used)
     warn_untagged_penetration(scene, problem)
     advise_striker(scene, problem)
-    warn_overhanging_pairs(scene, problem)
     if not finished_steps(out / "solution.xdmf"):  # no step on disk: nothing to open
         if comm.rank == 0:
             (out / SCRIPT).unlink(missing_ok=True)

@@ -7,14 +7,16 @@
 // Physical groups:
 //   Surface "left_support" = 1, "right_support" = 2, "bridge" = 3     (cell tags)
 //   Curve "left_base" = 1, "right_base" = 2, "left_top" = 3, "right_top" = 4,
-//   "bridge_over_left" = 5 (x in [0.5, 1]), "bridge_over_right" = 6 (x in [2, 2.5]),
-//   "bridge_under_left" = 7 (x in [0.5, 1.5]), "bridge_under_right" = 8 (x in [1.5, 2.5]),
-//   "bridge_top" = 9                                                   (facet tags)
+//   "bridge_under_left" = 5, "bridge_under_right" = 6: the bridge's underside over
+//   each support, x in [0.5, 1] and [2, 2.5]; with whole_underside = 1 each runs
+//   on over the gap to the middle, x in [0.5, 1.5] and [1.5, 2.5] (a striker
+//   that reaches past its target), "bridge_top" = 9                 (facet tags)
 DefineConstant[
   H = {0.5, Name "Parameters/support_height"},
   T = {0.3, Name "Parameters/bridge_thickness"},
   hs = {0.1, Name "Parameters/h_support"},
-  hb = {0.05, Name "Parameters/h_bridge"}
+  hb = {0.05, Name "Parameters/h_bridge"},
+  whole_underside = {0, Name "Parameters/whole_underside"}
 ];
 Geometry.AutoCoherence = 0;
 Point(1) = {0, 0, 0, hs}; Point(2) = {1, 0, 0, hs}; Point(3) = {1, H, 0, hs}; Point(4) = {0, H, 0, hs};
@@ -38,8 +40,11 @@ Physical Curve("left_base", 1) = {1};
 Physical Curve("right_base", 2) = {11};
 Physical Curve("left_top", 3) = {3};
 Physical Curve("right_top", 4) = {13};
-Physical Curve("bridge_over_left", 5) = {21};
-Physical Curve("bridge_over_right", 6) = {24};
-Physical Curve("bridge_under_left", 7) = {21, 22};
-Physical Curve("bridge_under_right", 8) = {23, 24};
+If (whole_underside)
+  Physical Curve("bridge_under_left", 5) = {21, 22};
+  Physical Curve("bridge_under_right", 6) = {23, 24};
+Else
+  Physical Curve("bridge_under_left", 5) = {21};
+  Physical Curve("bridge_under_right", 6) = {24};
+EndIf
 Physical Curve("bridge_top", 9) = {26};

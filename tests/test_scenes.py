@@ -188,3 +188,24 @@ def test_dirichlet_path_drives_a_one_body_scene(tmp_path):
             prescribed = values[~np.isnan(values[:, i]), i]
             assert prescribed.size > 0
             assert np.allclose(prescribed, expected[i], atol=1e-15), (t, i)
+
+
+def test_overlapping_physical_groups_are_refused_before_meshing(tmp_path):
+    """A curve in two physical groups would keep one tag only: named, with the fix."""
+    from fenics_contact.scene.build import build_mesh
+    from fenics_contact.scene.schema import SceneError, load_scene
+
+    shipped = Path(__file__).parents[1] / "scenes" / "bridge.toml"
+    geo = (shipped.parents[1] / "meshes" / "bridge.geo").read_text()
+    overlapping = geo.replace('Physical Curve("bridge_top", 9) = {26};',
+                              'Physical Curve("bridge_top", 9) = {26};\n'
+                              'Physical Curve("bridge_ends", 10) = {25, 26, 27};')
+    assert overlapping != geo
+    (tmp_path / "bridge.geo").write_text(overlapping)
+    scene_file = tmp_path / "bridge.toml"
+    scene_file.write_text(shipped.read_text().replace('"../meshes/bridge.geo"',
+                                                      f'"{tmp_path}/bridge.geo"'))
+    with pytest.raises(SceneError, match=r"bridge.geo: Curve 26 of the mesh file is in two "
+                                         r"physical groups, 'bridge_top' and 'bridge_ends'.*"
+                                         r"Make the groups disjoint"):
+        build_mesh(load_scene(scene_file))

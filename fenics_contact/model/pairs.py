@@ -52,6 +52,10 @@ COUPLING_GAP = 1.0
 #: A frictionless pair searches again only nodes that may have come within this many
 #: facet sizes of the target (DeformablePair._search).
 SKIN = 4.0
+#: How far past the rim of the target a striker node may lie and still be held, in its
+#: own facet size (DeformablePair.refresh): a quarter facet, where half the tributary
+#: length of a striker's end node has left the target.
+BEYOND_RIM = 0.25
 
 
 class DeformablePair:
@@ -136,6 +140,11 @@ class DeformablePair:
         self.n_owned = self.W.dofmap.index_map.size_local
         self.X = [fem.Function(self.W, name=f"target_X{k}") for k in range(nv)]
         self.w = [fem.Function(self.W, name=f"target_w{k}") for k in range(nv)]
+        #: Added to the gap of the nodes with no partner (component 0; length): a node
+        #: past the target's rim (:meth:`refresh`) is lifted to its distance from the
+        #: target, so it stays open and its written gap is that distance.
+        self.lift = fem.Function(self.W, name="gap_lift")
+        self._node_size = _node_sizes(surface.submesh, self.W)
         self.assignment = np.full(n_w, -1, np.int64)
         self.projection = None
         #: lam at each W block (owned first), set by a frictionless contact; None: every
@@ -198,8 +207,12 @@ class DeformablePair:
         return c / ufl.sqrt(ufl.dot(c, c))
 
     def gap(self, x_s: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
-        """Signed normal gap of the striker point ``x_s`` to its facet's plane (length)."""
-        return ufl.dot(x_s - self.positions()[0], self.normal())
+        """Signed normal gap of ``x_s`` to its facet's plane, plus the node's lift (length).
+
+        The lift is data (0 for a node that faces the target), so the tangent
+        is that of the plane gap.
+        """
+        return ufl.dot(x_s - self.positions()[0], self.normal()) + self.lift[0]
 
     def shape_weights(self, x_s: ufl.core.expr.Expr) -> list[ufl.core.expr.Expr]:
         """Weights N_k of the facet vertices at the projection of ``x_s`` (sum 1).
@@ -267,6 +280,7 @@ class DeformablePair:
         points = self.striker_positions()
         gathers = self.target.gathers
         w_t, proj = self._settled_search(points, lambda current: self._search(current))
+        self._lift_past_rim(points, (self.X_vertices + w_t)[self.facet_vertex], proj)
         if self.target.gathers != gathers and self.w_prev is not None:
             self._prev_t = self.target_displacements(self._u_prev)  # new vertex numbering
         self.search_count += 1
@@ -286,6 +300,28 @@ class DeformablePair:
         if changed or moved:
             self.version += 1
         return changed
+
+    def _lift_past_rim(self, points: np.ndarray, current: np.ndarray, proj: Projection) -> None:
+        """Lift the gap of the nodes past the target's rim to their distance from it.
+
+        Past a free side of the target (its end in 2D, the rim of the patch in
+        3D) the plane of the last facet extends over nothing: a striker running
+        on beyond the target would be held level with it and its force counted
+        (a bridge across two supports: +19 %). A node whose projection falls on
+        no facet at its closest point, farther than :data:`BEYOND_RIM` of its own
+        facet size from it, gets the lift d - g: its gap becomes d, its distance
+        from the target (> 0).
+        """
+        lift = np.zeros(points.shape[0])
+        maybe = np.flatnonzero(proj.overshoot > 0.0)
+        if maybe.size and current.shape[0]:
+            near = _closest(current, points[maybe], self._size)
+            past = past_free_edge(points[maybe], current, self.target.free, size=self._size,
+                                  nearest=near, reach=BEYOND_RIM * self._node_size[maybe])
+            rows = maybe[past]
+            plane = self._plane_gaps(points[rows], current[proj.facet[rows]])
+            lift[rows] = near.distance[past] - plane
+        self.lift.x.array.reshape(-1, self.gdim)[:, 0] = lift
 
     def _settled_search(self, points: np.ndarray, search) -> tuple[np.ndarray, Projection]:
         """Run ``search(current facets)`` until the kept facets settle ``points`` (collective).
@@ -369,15 +405,6 @@ class DeformablePair:
         points, current, nearest = self._closest_on_surface()
         return penetration_depth(points, current, size=self._size, nearest=nearest)
 
-    def past_free_edge(self) -> np.ndarray:
-        """Owned striker nodes whose closest target point lies on a free edge, past it (bool).
-
-        Node-to-segment measures such a node's gap to the plane of the target's
-        last facet, extended past the surface's end (collective).
-        """
-        points, current, nearest = self._closest_on_surface()
-        return past_free_edge(points, current, size=self._size, nearest=nearest)
-
     def _closest_on_surface(self) -> tuple[np.ndarray, np.ndarray, Projection]:
         """(owned striker positions, current target facet vertices, closest projections).
 
@@ -401,9 +428,9 @@ class DeformablePair:
         return [self.target_blocks[facet, k] for k in range(self.gdim)]
 
     # -- condensation ----------------------------------------------------------------
-    def gap_offset(self) -> np.ndarray | float:
-        """What the pair adds to the gap to the assigned facet's plane (length; none here)."""
-        return 0.0
+    def gap_offset(self) -> np.ndarray:
+        """What the pair adds to the gap to the assigned facet's plane: the lift (length)."""
+        return self.lift.x.array.reshape(-1, self.gdim)[:, 0]
 
     def coupled(self, w_t: np.ndarray) -> np.ndarray:
         """Owned nodes whose contact can act at the current state (bool).
@@ -624,6 +651,21 @@ class NodeToSegmentContact(Contact):
         out.x.scatter_forward()
         vec.destroy()
         return out
+
+
+def _node_sizes(submesh: mesh.Mesh, W: fem.FunctionSpace) -> np.ndarray:
+    """Mean diameter of the striker facets at each W block (owned and ghost; length)."""
+    x = submesh.geometry.x
+    cells = x[submesh.geometry.dofmaps[0]]  # (cells, nv, 3)
+    nv = cells.shape[1]
+    diameter = np.max([np.linalg.norm(cells[:, i] - cells[:, j], axis=-1)
+                       for i in range(nv) for j in range(i + 1, nv)], axis=0)
+    blocks = W.dofmap.list
+    n = W.dofmap.index_map.size_local + W.dofmap.index_map.num_ghosts
+    total, count = np.zeros(n), np.zeros(n)
+    np.add.at(total, blocks.reshape(-1), np.repeat(diameter, blocks.shape[1]))
+    np.add.at(count, blocks.reshape(-1), 1.0)
+    return total / np.maximum(count, 1.0)
 
 
 def _closest(current: np.ndarray, points: np.ndarray, size: float,

@@ -291,20 +291,55 @@ def penetration_depth(points: np.ndarray, vertices: np.ndarray, candidates: int 
     return np.where(behind & on_surface, nearest.distance, 0.0)
 
 
-def past_free_edge(points: np.ndarray, vertices: np.ndarray, candidates: int = 8,
-                   size: float | None = None, nearest: Projection | None = None) -> np.ndarray:
-    """Whether each point's closest point of the surface lies on a free edge, the point beyond.
+def past_free_edge(points: np.ndarray, vertices: np.ndarray, free: np.ndarray,
+                   candidates: int = 8, size: float | None = None,
+                   nearest: Projection | None = None,
+                   reach: np.ndarray | float = 0.0) -> np.ndarray:
+    """Whether each point lies past the rim of the surface (bool).
 
-    A free edge bounds one facet of the surface only (the end of a polyline, the
-    rim of a patch); a point past it (by more than the tie tolerance) faces no
-    part of the surface. Arguments as :func:`penetration_depth`.
+    The rim is made of the free sides of the facets (2D: the end vertices of
+    the polyline; 3D: the edges of the patch that one facet alone holds). A
+    point is past it when its closest point of the surface lies on the rim,
+    no facet that touches that closest point holds the point's projection on
+    its plane, and the point is farther than ``reach`` from it. Such a point
+    faces no part of the surface; the body's other faces are there, not this
+    surface.
+
+    Args:
+        points: (n, gdim) positions.
+        vertices: (m, nv, gdim) facet vertices, ordered so the normals point outward.
+        free: (m, nv) bool, the free sides of each facet (side k: 2D the end
+            vertex k, 3D the edge opposite vertex k).
+        candidates: nearest facets (by centroid) examined per point.
+        size: the tie tolerance's length scale (:class:`SurfaceSearch`).
+        nearest: ``SurfaceSearch(vertices, candidates, size).closest(points)``
+            when the caller has it already.
+        reach: per point or for all, the distance from the rim within which a
+            point past it still counts as facing the surface (length).
     """
     points = np.asarray(points, float)
-    if points.shape[0] == 0:
+    n = points.shape[0]
+    if n == 0:
         return np.zeros(0, bool)
-    nearest, _, _, on_surface = _closest_ties(points, vertices, candidates, size, nearest)
-    scale = SurfaceSearch(vertices, candidates, size=size).size
-    return ~on_surface & (nearest.overshoot > TIE_TOL * scale)
+    nearest, idx, ties, _ = _closest_ties(points, vertices, candidates, size, nearest)
+    closest = _closest_points(points, vertices[nearest.facet])
+    facets = vertices[idx]  # (n, k, nv, gdim)
+    xi_c, _, _ = project(closest, facets)
+    nv = vertices.shape[1]
+    bary = np.concatenate([1.0 - xi_c.sum(axis=-1, keepdims=True), xi_c], axis=-1)
+    on_rim = np.zeros(idx.shape, bool)
+    for k in range(nv):
+        others = [j for j in range(nv) if j not in _side(nv, k)]
+        on_side = np.all(np.abs(bary[..., others]) <= 1e-9, axis=-1)
+        on_rim |= on_side & free[idx][..., k]
+    _, _, over = project(points, facets)
+    held = np.any(ties & (over <= 1e-9), axis=1)
+    return np.any(ties & on_rim, axis=1) & ~held & (nearest.distance > reach)
+
+
+def _side(nv: int, k: int) -> tuple[int, ...]:
+    """The facet vertices of side k: 2D the end vertex k, 3D the edge opposite vertex k."""
+    return (k,) if nv == 2 else ((k + 1) % 3, (k + 2) % 3)
 
 
 def _closest_ties(points: np.ndarray, vertices: np.ndarray, candidates: int,

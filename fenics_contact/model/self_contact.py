@@ -33,7 +33,6 @@ g >= 0 open, lam <= 0 the pressure.
 from __future__ import annotations
 
 import numpy as np
-from dolfinx import fem
 from scipy.sparse import coo_matrix, csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
@@ -229,17 +228,10 @@ class SelfContactPair(DeformablePair):
         self.excluded = neighbourhoods(X, self.union_facets, self.striker_vertex,
                                        self.neighbourhood)[:, :m]
         self._X_union = X
-        #: Added to the gap of the nodes no facet qualifies for (component 0; length).
-        self.lift = fem.Function(self.W, name="self_contact_lift")
         self._lift_length = 100.0 * float(np.ptp(X, axis=0).max(initial=1.0))
 
-    def gap(self, x_s):
-        """The pair's gap plus the lift of the nodes with no partner (length, >= 0 open)."""
-        return super().gap(x_s) + self.lift[0]
-
-    def gap_offset(self) -> np.ndarray:
-        """The lift of each node with no partner (length; 0 for the others)."""
-        return self.lift.x.array.reshape(-1, self.gdim)[:, 0]
+    def _lift_past_rim(self, points, current, proj) -> None:
+        """Nothing here: :meth:`_search` lifts the nodes no facet qualifies for."""
 
     def _search(self, current: np.ndarray) -> Projection:
         lift = self.lift.x.array.reshape(-1, self.gdim)

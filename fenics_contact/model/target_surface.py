@@ -21,6 +21,11 @@ smallest reach that settles every node, and the facets are exchanged again.
 
 ``keep_all=True`` keeps every facet on every rank (the self-contact search,
 which needs the whole surface).
+
+Each facet travels with its *free sides*: the sides (2D: end vertices; 3D:
+edges) that no other facet of the whole target surface shares, its rim.
+They are counted once over all ranks, so a kept facet's side is free only
+where the target surface really ends, not where the kept part does.
 """
 
 from __future__ import annotations
@@ -36,6 +41,40 @@ from petsc4py import PETSc
 REACH_FACETS = 2.0
 #: Growth factor of the trial reaches when some node is not settled.
 GROWTH = 1.5
+
+
+def free_sides(blocks: np.ndarray, comm: MPI.Comm) -> np.ndarray:
+    """Which sides of each facet no other facet of the surface shares (collective).
+
+    Args:
+        blocks: (m, nv) global V blocks of the vertices of this rank's facets.
+        comm: the communicator the surface's facets are spread over.
+
+    Returns:
+        (m, nv) bool. Side k: 2D the end vertex k, 3D the edge opposite vertex k.
+    """
+    m, nv = blocks.shape
+    sides = [(k,) for k in range(2)] if nv == 2 else [((k + 1) % 3, (k + 2) % 3) for k in range(3)]
+    keys = np.stack([np.sort(blocks[:, list(v)], axis=1) for v in sides], axis=1)
+    keys = keys.reshape(m * nv, len(sides[0]))  # one row per (facet, side)
+    if comm.size == 1:
+        _, inverse, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
+        return (counts[inverse.reshape(-1)] == 1).reshape(m, nv)
+    # each side is counted on the rank its first vertex hashes to
+    owner = keys[:, 0] % comm.size
+    order = np.argsort(owner, kind="stable")
+    sent = comm.alltoall([keys[order[owner[order] == r]] for r in range(comm.size)])
+    got = np.concatenate(sent) if sent else np.zeros((0, keys.shape[1]), np.int64)
+    if got.shape[0]:
+        _, inverse, counts = np.unique(got, axis=0, return_inverse=True, return_counts=True)
+        once = counts[inverse.reshape(-1)] == 1
+    else:
+        once = np.zeros(0, bool)
+    sizes = np.cumsum([0, *(a.shape[0] for a in sent)])
+    back = comm.alltoall([once[sizes[r]:sizes[r + 1]] for r in range(comm.size)])
+    free = np.zeros(m * nv, bool)
+    free[order] = np.concatenate(back) if back else np.zeros(0, bool)
+    return free.reshape(m, nv)
 
 
 def _outside_distance(points: np.ndarray, target: np.ndarray, box: np.ndarray) -> np.ndarray:
@@ -75,6 +114,7 @@ class TargetSurface:
         blocks: (k, nv) global V blocks of their vertices.
         vertices: the distinct global V blocks; ``facet_vertex`` indexes them.
         X_vertices: (len(vertices), gdim) reference positions (length).
+        free: (k, nv) bool, the free sides of each kept facet (:func:`free_sides`).
         gathers: how many exchanges were made.
     """
 
@@ -95,6 +135,7 @@ class TargetSurface:
         )
         self._own_X = np.asarray(X, float).reshape(m, self.nv, self.gdim)
         self._own_gid = (comm.exscan(m) or 0) + np.arange(m, dtype=np.int64)
+        self._own_free = free_sides(self._own_blocks, comm)
         self.num_global = comm.allreduce(m)
         self._own_vertex = np.unique(self._own_local)
         self._own_vertex_X = np.zeros((self._own_vertex.size, self.gdim))
@@ -104,6 +145,7 @@ class TargetSurface:
         self.gid = np.zeros(0, np.int64)
         self.blocks = np.zeros((0, self.nv), np.int64)
         self._X = np.zeros((0, self.nv, self.gdim))
+        self.free = np.zeros((0, self.nv), bool)
         self.box: np.ndarray | None = None
         self.gathers = 0
         self._scatter: PETSc.Scatter | None = None
@@ -154,13 +196,15 @@ class TargetSurface:
         send = []
         for other in boxes:
             hit = np.flatnonzero(np.all((hi >= other[0]) & (lo <= other[1]), axis=1))
-            send.append((self._own_gid[hit], self._own_blocks[hit], self._own_X[hit]))
+            send.append((self._own_gid[hit], self._own_blocks[hit], self._own_X[hit],
+                         self._own_free[hit]))
         got = self.comm.alltoall(send)
         gid = np.concatenate([self.gid, *(g[0] for g in got)])
         blocks = np.concatenate([self.blocks, *(g[1] for g in got)])
         X = np.concatenate([self._X, *(g[2] for g in got)])
+        free = np.concatenate([self.free, *(g[3] for g in got)])
         gid, first = np.unique(gid, return_index=True)  # kept facets stay kept
-        self.gid, self.blocks, self._X = gid, blocks[first], X[first]
+        self.gid, self.blocks, self._X, self.free = gid, blocks[first], X[first], free[first]
         self.vertices, inverse = np.unique(self.blocks, return_inverse=True)
         self.facet_vertex = inverse.reshape(-1, self.nv)
         self.X_vertices = np.zeros((self.vertices.size, gd))

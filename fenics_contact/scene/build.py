@@ -45,7 +45,7 @@ from fenics_contact.scene.checks import (
     held_by_closed_contacts,
     warn_locking,
 )
-from fenics_contact.scene.meshing import gmsh_session, mesh_on_rank, open_geo
+from fenics_contact.scene.meshing import gmsh_session, mesh_on_rank, open_geo, overlapping_groups
 from fenics_contact.scene.pairing import pairing_contacts
 from fenics_contact.scene.schema import (
     GENERATOR_TAGS,
@@ -110,7 +110,8 @@ def _open(gmsh: Any, scene: Scene) -> None:
 def _physical_groups(scene: Scene, comm: MPI.Comm) -> dict[tuple[int, int], str]:
     """The file's physical groups, {(dim, tag): name}, read on rank 0, known to all.
 
-    A file gmsh cannot read raises SceneError (on every rank) naming it.
+    A file gmsh cannot read, or whose groups overlap (a mesh keeps one tag
+    per cell and facet), raises SceneError (on every rank) naming it.
     """
     groups: dict[tuple[int, int], str] = {}
     problem: str | None = None
@@ -120,6 +121,9 @@ def _physical_groups(scene: Scene, comm: MPI.Comm) -> dict[tuple[int, int], str]
                 _open(gmsh, scene)
                 for d, t in gmsh.model.getPhysicalGroups():
                     groups[(d, t)] = gmsh.model.getPhysicalName(d, t)
+                overlap = overlapping_groups(gmsh)
+                if overlap:
+                    problem = f"{scene.path.name}: [mesh] {scene.mesh.file.name}: {overlap}"
             except SceneError as exc:  # the file was read; the scene asks what it lacks
                 problem = str(exc)
             except Exception as exc:  # gmsh raises bare Exception

@@ -72,6 +72,30 @@ def mesh_on_rank(
                 gmsh.model.remove()
 
 
+def overlapping_groups(gmsh: Any) -> str:
+    """Why the model's physical groups cannot become mesh tags ("" when they can).
+
+    A mesh keeps one tag per cell and per facet: an entity in two physical
+    groups of one dimension would silently stay in one of them only (a
+    striker tagged over a part that another group also holds loses it).
+    """
+    kinds = {0: "Point", 1: "Curve", 2: "Surface", 3: "Volume"}
+    for dim in range(4):
+        holder: dict[int, tuple[int, str]] = {}
+        for _, tag in gmsh.model.getPhysicalGroups(dim):
+            name = gmsh.model.getPhysicalName(dim, tag) or str(tag)
+            for entity in gmsh.model.getEntitiesForPhysicalGroup(dim, tag):
+                entity = int(entity)
+                if entity in holder and dim > 0:
+                    other = holder[entity][1]
+                    return (f"{kinds[dim]} {entity} of the mesh file is in two physical groups, "
+                            f"{other!r} and {name!r}; a mesh keeps one tag per cell and facet, so "
+                            "one group would silently lose it. Make the groups disjoint: give each "
+                            "entity one group.")
+                holder[entity] = (tag, name)
+    return ""
+
+
 def open_geo(gmsh: Any, path: Path | str, parameters: dict[str, float]) -> None:
     """Open a gmsh .geo or .msh file in the current session with ``parameters`` set.
 
