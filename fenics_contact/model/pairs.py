@@ -403,7 +403,8 @@ class DeformablePair:
         positive.
         """
         points, current, nearest = self._closest_on_surface()
-        return penetration_depth(points, current, size=self._size, nearest=nearest)
+        return penetration_depth(points, current, size=self._size, nearest=nearest,
+                                 free=self.target.free)
 
     def _closest_on_surface(self) -> tuple[np.ndarray, np.ndarray, Projection]:
         """(owned striker positions, current target facet vertices, closest projections).

@@ -263,15 +263,16 @@ def _closest_points(points: np.ndarray, facets: np.ndarray) -> np.ndarray:
 
 
 def penetration_depth(points: np.ndarray, vertices: np.ndarray, candidates: int = 8,
-                      size: float | None = None,
-                      nearest: Projection | None = None) -> np.ndarray:
+                      size: float | None = None, nearest: Projection | None = None,
+                      free: np.ndarray | None = None) -> np.ndarray:
     """How deep each point lies inside an oriented surface, by closest point (length; 0 outside).
 
     The actual surface, not the plane of an assigned facet: the closest point
     over all facets, and the side from the pseudo-normal (the sum of the
     normals of every facet that shares that closest point), which is right at
-    edges and vertices where one facet's plane is not. Points whose closest
-    point lies on a free edge of the surface count as outside.
+    edges and vertices where one facet's plane is not. Points past the rim of
+    the surface (:func:`past_free_edge` with no reach) count as outside; without
+    ``free``, those whose closest point lies on one facet only, at its border.
 
     Args:
         points: (n, gdim) positions.
@@ -280,11 +281,15 @@ def penetration_depth(points: np.ndarray, vertices: np.ndarray, candidates: int 
         size: the tie tolerance's length scale (:class:`SurfaceSearch`).
         nearest: ``SurfaceSearch(vertices, candidates, size).closest(points)``
             when the caller has it already.
+        free: (m, nv) bool, the free sides of each facet (see :func:`past_free_edge`).
     """
     points = np.asarray(points, float)
     if points.shape[0] == 0:
         return np.zeros(0)
     nearest, idx, ties, on_surface = _closest_ties(points, vertices, candidates, size, nearest)
+    if free is not None:
+        on_rim, held = _rim(points, vertices, free, nearest, idx, ties)
+        on_surface = ~on_rim | held
     pseudo = np.einsum("ij,ijk->ik", ties.astype(float), facet_normals(vertices)[idx])
     closest = _closest_points(points, vertices[nearest.facet])
     behind = np.einsum("ij,ij->i", points - closest, pseudo) < 0.0
@@ -322,6 +327,13 @@ def past_free_edge(points: np.ndarray, vertices: np.ndarray, free: np.ndarray,
     if n == 0:
         return np.zeros(0, bool)
     nearest, idx, ties, _ = _closest_ties(points, vertices, candidates, size, nearest)
+    on_rim, held = _rim(points, vertices, free, nearest, idx, ties)
+    return on_rim & ~held & (nearest.distance > reach)
+
+
+def _rim(points: np.ndarray, vertices: np.ndarray, free: np.ndarray, nearest: Projection,
+         idx: np.ndarray, ties: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(closest point on the rim, projection held by a facet touching it), per point."""
     closest = _closest_points(points, vertices[nearest.facet])
     facets = vertices[idx]  # (n, k, nv, gdim)
     xi_c, _, _ = project(closest, facets)
@@ -334,7 +346,7 @@ def past_free_edge(points: np.ndarray, vertices: np.ndarray, free: np.ndarray,
         on_rim |= on_side & free[idx][..., k]
     _, _, over = project(points, facets)
     held = np.any(ties & (over <= 1e-9), axis=1)
-    return np.any(ties & on_rim, axis=1) & ~held & (nearest.distance > reach)
+    return np.any(ties & on_rim, axis=1), held
 
 
 def _side(nv: int, k: int) -> tuple[int, ...]:
