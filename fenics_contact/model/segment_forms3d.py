@@ -9,7 +9,8 @@ with a fixed capacity; a search only refills its DG0 coefficients:
   and target triangle (rows 3-5), shape (6, 3);
 * ``w``: their displacements, the *extended unknowns* (6, 3), selected from
   the bodies' displacement by the search (condensed as in 2D);
-* ``provenance``: one-hot weights of each corner's kind and indices (3, 15).
+* ``provenance``: one-hot weights of each corner's kind and indices, and
+  of each target vertex's snap code (3, 22).
 
 The corners (:func:`~.segments3d.corner_from_provenance`, written in UFL),
 the striker point, the gap along the striker normal and the hat functions
@@ -43,8 +44,11 @@ from mpi4py import MPI
 from fenics_contact.model.segments3d import REFERENCE, STRIKER_EDGES, Segments
 
 #: Columns of a corner's provenance row: kind (3), striker corner (3), target
-#: vertex (3), striker edge (3), target edge (3).
-KIND, CORNER, VERTEX, EDGE, TARGET_EDGE = 0, 3, 6, 9, 12
+#: vertex (3), striker edge (3), target edge (3); then, in row r, the snap code of the
+#: target vertex r (7: not moved, onto edge line 0, 1, 2, onto corner 0, 1, 2).
+KIND, CORNER, VERTEX, EDGE, TARGET_EDGE, SNAP = 0, 3, 6, 9, 12, 15
+#: Width of a provenance row.
+WIDTH = 22
 #: C optimisation of the second-derivative kernel: gcc takes about 8 s at -O0 and
 #: 170 s at -O1 on it (2-core machine); -O1 assembles it 2.3 times faster, but it
 #: is assembled only on the segments of engaged nodes (docs/two_bodies.md).
@@ -55,10 +59,12 @@ _DUMMY = np.vstack([np.column_stack([REFERENCE, np.zeros(3)]),
 
 
 def provenance_weights(segments: Segments) -> np.ndarray:
-    """One-hot provenance rows of every segment corner, shape (k, 3, 15)."""
+    """One-hot provenance rows of every segment corner and snap code, shape (k, 3, WIDTH)."""
     k = len(segments)
-    out = np.zeros((k, 3, 15))
+    out = np.zeros((k, 3, WIDTH))
     rows = np.arange(k)
+    for r in range(3):
+        out[rows, r, SNAP + 1 + segments.snap[:, r]] = 1.0
     for c in range(3):
         kind, i, j = segments.kind[:, c], segments.index[:, c, 0], segments.index[:, c, 1]
         out[rows, c, KIND + kind] = 1.0
@@ -95,7 +101,7 @@ class SegmentForms:
         self.W6 = fem.functionspace(self.mesh, ("DG", 0, (6, 3)))
         self.X = fem.Function(self.W6, name="segment_vertices")
         self.w = fem.Function(self.W6, name="segment_displacements")
-        self.provenance = fem.Function(fem.functionspace(self.mesh, ("DG", 0, (3, 15))))
+        self.provenance = fem.Function(fem.functionspace(self.mesh, ("DG", 0, (3, WIDTH))))
         self.V3 = fem.functionspace(self.mesh, ("DG", 0, (3,)))
         self.count = 0
         gap, jac, shape = self._integrand()
@@ -118,7 +124,7 @@ class SegmentForms:
         self.hessian_form = ufl.derivative(ufl.derivative(weighted, self.w, dw), self.w, dW)
         self._compiled: dict[str, fem.Form] | None = None
         self._matrices: dict = {}
-        self.fill(np.zeros((0, 6, 3)), np.zeros((0, 3, 15)))
+        self.fill(np.zeros((0, 6, 3)), np.zeros((0, 3, WIDTH)))
 
     def compiled(self) -> dict[str, fem.Form]:
         """The five forms compiled (once; the large Hessian kernel at HESSIAN_OPT)."""
@@ -177,8 +183,18 @@ class SegmentForms:
         n = ufl.cross(e1, e2)
         det = ufl.dot(n, n)
         m1, m2 = ufl.cross(e2, n) / det, ufl.cross(n, e1) / det
-        projected = [ufl.as_vector([ufl.dot(q - s[0], m1), ufl.dot(q - s[0], m2)]) for q in t]
         reference = [ufl.as_vector([float(a), float(b)]) for a, b in REFERENCE]
+
+        def moved(k: int):
+            """Target vertex k projected, then moved as its snap code says (segments3d.snapped)."""
+            q = ufl.as_vector([ufl.dot(t[k] - s[0], m1), ufl.dot(t[k] - s[0], m2)])
+            half = 0.5 * (q[0] + q[1] - 1.0)
+            onto = [ufl.as_vector([q[0], 0.0]), q - ufl.as_vector([half, half]),
+                    ufl.as_vector([0.0, q[1]])]
+            return (p[k, SNAP] * q + sum(p[k, SNAP + 1 + i] * onto[i] for i in range(3))
+                    + sum(p[k, SNAP + 4 + c] * reference[c] for c in range(3)))
+
+        projected = [moved(k) for k in range(3)]
 
         def crossing(a, b, edge: int):
             ca, cb, cc = (float(v) for v in STRIKER_EDGES[edge])
@@ -209,7 +225,7 @@ class SegmentForms:
         return gap, jac, shape
 
     def fill(self, vertices: np.ndarray, provenance: np.ndarray) -> None:
-        """Load k <= capacity segments: (k, 6, 3) reference vertices, (k, 3, 15) provenance.
+        """Load k <= capacity segments: (k, 6, 3) reference vertices, (k, 3, WIDTH) provenance.
 
         The displacements ``w`` are set to zero; the remaining cells are emptied.
         """
@@ -218,7 +234,7 @@ class SegmentForms:
             raise ValueError(f"{k} segments exceed the segment mesh's capacity "
                              f"{self.capacity}; make it larger.")
         allv = np.broadcast_to(_DUMMY, (self.capacity, 6, 3)).copy()
-        allp = np.zeros((self.capacity, 3, 15))
+        allp = np.zeros((self.capacity, 3, WIDTH))
         allv[:k], allp[:k] = vertices, provenance
         self.X.x.array[:] = allv[self.cell_rows].reshape(-1)
         self.provenance.x.array[:] = allp[self.cell_rows].reshape(-1)

@@ -9,19 +9,42 @@ covers. This module finds them, in the current configuration:
 1. T's vertices are projected along n_s onto S's plane and written in S's
    local coordinates xi = (xi_1, xi_2) (x = s_0 + xi_1 (s_1 - s_0) + xi_2
    (s_2 - s_0)); S itself is the reference triangle (0, 0), (1, 0), (0, 1);
-2. the projected T is clipped against S (Sutherland-Hodgman: both convex),
+2. a projected vertex less than CLIP_TOL from the line of one of S's edges
+   is moved onto that line (orthogonally in xi), one near two of the lines
+   onto the corner they share (:func:`snap_codes`, :func:`snapped`); a
+   target edge whose two ends were moved onto one line *is* that striker
+   edge for the clipping;
+3. the projected T is clipped against S (Sutherland-Hodgman: both convex),
    giving a convex polygon of at most six vertices;
-3. the polygon is cut into triangles fanned from its first vertex.
+4. the polygon is cut into triangles fanned from its first vertex.
+
+Step 2 is for surfaces whose edges lie on one line: the rims of two faces
+that end together, and interior edges that coincide (two meshes that are
+mirror images, or structured alike). There the crossing of a striker edge
+with a target edge along it is ill-conditioned (its derivative is as large
+as 1 / distance) and, with the two edges apart by round-off, which of the
+two target triangles along the edge covers the sliver between them flips
+from one search to the next. Moved onto the line, the vertex is on it for
+every target triangle it belongs to (the move depends on the vertex and S
+only): the moved target triangles still tile the plane, the triangle on the
+far side of the edge covers nothing and the near one covers up to the edge
+exactly, and the moved position is a linear function of the projected one,
+so the segment corners stay smooth functions of the vertex positions while
+the vertex stays within the tolerance.
 
 Every polygon vertex carries its *provenance*, which says how it moves
 with the bodies, so that a UFL expression can rebuild it from the vertex
 positions and ``ufl.derivative`` can linearise the segmentation:
 
 * ``STRIKER_VERTEX`` k: the corner k of S (xi fixed);
-* ``TARGET_VERTEX`` k: T's vertex k projected along n_s;
+* ``TARGET_VERTEX`` k: T's vertex k projected along n_s (and moved by step 2);
 * ``EDGE_CROSSING`` (i, k): S's edge i (from corner i to corner i + 1
   mod 3, see :data:`STRIKER_EDGES`) crossing T's projected edge k (from T's
-  vertex k to vertex k + 1 mod 3).
+  vertex k to vertex k + 1 mod 3, its ends moved by step 2).
+
+The moves of step 2 are the pair's *snap codes*, one per target vertex
+(:data:`NOT_SNAPPED`, onto edge line i, or onto corner c as ``CORNER_SNAP + c``),
+kept with every segment and frozen with the provenance between searches.
 
 :func:`corner_from_provenance` evaluates those formulas (the same algebra
 a UFL form would hold); the tests check that it reproduces the clipped
@@ -53,11 +76,19 @@ STRIKER_EDGES = np.array([[0.0, 1.0, 0.0], [1.0, 1.0, 1.0], [1.0, 0.0, 0.0]])
 REFERENCE = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
 #: Polygons thinner than this (in xi area) are dropped.
 AREA_TOL = 1e-14
-#: A target vertex at most this far outside a striker edge (in xi) counts as inside: the
-#: crossing of two nearly collinear edges (the rims of two faces that end together) is
+#: A projected target vertex less than this (in xi) from the line of a striker edge is
+#: moved onto the line (:func:`snapped`): the crossing of two nearly collinear edges is
 #: ill-conditioned, and its derivative, large as 1 / distance, would swamp the tangent.
-#: The sliver so kept is at most this wide.
+#: Nothing else is kept outside a striker edge (an earlier rule counted a target vertex up
+#: to this far outside as inside: crossings near a striker corner were kept outside too,
+#: and their corner slid along the striker edge as the target moved).
 CLIP_TOL = 1e-6
+#: Snap code of a target vertex left where it is; 0, 1, 2: moved onto that striker edge's
+#: line; CORNER_SNAP + c: moved onto the striker's corner c.
+NOT_SNAPPED, CORNER_SNAP = -1, 3
+#: The striker edges a snap code puts a vertex on, as a bit mask (bit i: edge i), indexed
+#: by code + 1: none, edge 0, 1, 2, corner 0 (edges 0 and 2), 1 (0, 1), 2 (1, 2).
+_ON_LINES = np.array([0, 1, 2, 4, 5, 3, 6])
 #: Cosine of the largest angle between n_s and -n_t for a target triangle to count.
 OPPOSING = 0.2
 
@@ -73,6 +104,9 @@ class Segments:
         kind: (k, 3) provenance kind of each corner (``STRIKER_VERTEX``, ...).
         index: (k, 3, 2) provenance indices: (corner, -1), (target vertex, -1)
             or (striker edge, target edge).
+        snap: (k, 3) snap code of each of the target triangle's vertices
+            (:func:`snap_codes`), which the target vertices and edges in the
+            provenance refer to.
     """
 
     striker: np.ndarray
@@ -80,6 +114,7 @@ class Segments:
     xi: np.ndarray
     kind: np.ndarray
     index: np.ndarray
+    snap: np.ndarray
 
     def __len__(self) -> int:
         return int(self.striker.size)
@@ -116,21 +151,54 @@ def local_coordinates(striker: np.ndarray, points: np.ndarray) -> np.ndarray:
     return np.stack([d @ m1, d @ m2], axis=-1)
 
 
-def _inside(point: np.ndarray, edge: int) -> float:
-    """Signed distance-like value, >= 0 on the striker's side of its edge ``edge``."""
-    a, b, c = STRIKER_EDGES[edge]
-    value = a * point[0] + b * point[1] - c
-    return value if edge == 0 or edge == 2 else -value
+#: Snap code of a vertex near the striker edges of a bit mask (bit i: edge i), indexed by
+#: the mask: none, edge 0, edge 1, corner 1, edge 2, corner 0, corner 2 (all three: none).
+_CODE_OF_MASK = np.array([NOT_SNAPPED, 0, 1, CORNER_SNAP + 1, 2, CORNER_SNAP,
+                          CORNER_SNAP + 2, NOT_SNAPPED])
+#: The lowest set bit of a mask of striker edges (the edge two snapped vertices share).
+_LOWEST_BIT = np.array([-1, 0, 1, 0, 2, 0, 1, 0])
+
+
+def snap_codes(target_xi: np.ndarray) -> np.ndarray:
+    """Snap codes (..., 3) of projected target vertices (..., 3, 2): see :data:`CLIP_TOL`.
+
+    A vertex less than CLIP_TOL (the value a xi_1 + b xi_2 - c of
+    :data:`STRIKER_EDGES`) from one striker edge's line gets that edge's
+    number, from two lines ``CORNER_SNAP`` + the corner they share, else
+    ``NOT_SNAPPED``. The lines are whole lines: a vertex beyond the end of a
+    striker edge but on its line is moved too (the target edge through it
+    lies along the striker edge).
+    """
+    x = np.asarray(target_xi, float)
+    mask = sum((np.abs(_edge_value(x, edge)) <= CLIP_TOL).astype(np.int64) << edge
+               for edge in range(3))
+    return _CODE_OF_MASK[mask]
+
+
+def snapped(target_xi: np.ndarray, codes: np.ndarray) -> np.ndarray:
+    """Projected target vertices (..., 3, 2) moved as their snap codes (..., 3) say.
+
+    Onto the line of edge 0 (xi_2 = 0) or 2 (xi_1 = 0) by dropping that
+    coordinate, onto that of edge 1 (xi_1 + xi_2 = 1) along (1, 1), onto a
+    corner: the corner. The same algebra as the UFL forms.
+    """
+    x = np.asarray(target_xi, float)
+    codes = np.asarray(codes)
+    half = 0.5 * (x[..., 0] + x[..., 1] - 1.0)
+    xi1 = np.where(codes == 2, 0.0, np.where(codes == 1, x[..., 0] - half, x[..., 0]))
+    xi2 = np.where(codes == 0, 0.0, np.where(codes == 1, x[..., 1] - half, x[..., 1]))
+    out = np.stack([xi1, xi2], axis=-1)
+    corner = codes >= CORNER_SNAP
+    return np.where(corner[..., None], REFERENCE[np.where(corner, codes - CORNER_SNAP, 0)],
+                    out)
 
 
 def _crossing(p: np.ndarray, q: np.ndarray, edge: int) -> np.ndarray:
     """The point of segment p-q on the line of the striker's edge ``edge``.
 
     The clipping asks for it only between a vertex strictly inside and one
-    outside, so it lies on the segment: a vertex inside only by CLIP_TOL is
-    its own exit or entry point (the line through it and its outside
-    neighbour may meet the edge's line far away when both are nearly
-    parallel).
+    outside, so it lies on the segment (a vertex on the edge's line is its
+    own exit or entry point).
     """
     a, b, c = STRIKER_EDGES[edge]
     fp, fq = a * p[0] + b * p[1] - c, a * q[0] + b * q[1] - c
@@ -142,45 +210,70 @@ def clip(target_xi: np.ndarray) -> list[tuple[np.ndarray, tuple[int, int, int]]]
     """The projected target triangle (3, 2) clipped against the reference triangle.
 
     Returns the polygon's vertices, counter-clockwise, each with its
-    provenance (kind, i, j). The target triangle may come in either orientation.
+    provenance (kind, i, j). The target triangle may come in either
+    orientation. Its vertices are first moved as their snap codes say
+    (:func:`snap_codes`, :func:`snapped`); a target edge whose two ends are
+    on one striker edge's line is that edge, and a vertex on a striker
+    edge's line is on it exactly (its own entry or exit point, never
+    crossed).
     """
     tri = np.asarray(target_xi, float)
+    codes = snap_codes(tri)
+    moved = snapped(tri, codes)
+    on_lines = _ON_LINES[codes + 1]
     e1, e2 = tri[1] - tri[0], tri[2] - tri[0]
     order = [0, 1, 2] if e1[0] * e2[1] - e1[1] * e2[0] > 0 else [0, 2, 1]
-    # each vertex: (xi, provenance); each edge (from vertex v to the next) carries a line:
-    # ("t", k) target edge from vertex k to k + 1 mod 3 (in T's own numbering), ("s", i).
-    poly = [(tri[k], (TARGET_VERTEX, k, -1)) for k in order]
+    # each vertex: (xi, provenance, the striker edges it lies on as a bit mask); each edge
+    # (from vertex v to the next) carries a line: ("t", k) target edge from vertex k to
+    # k + 1 mod 3 (in T's own numbering), ("s", i) the line of striker edge i.
+    poly = [(moved[k], (TARGET_VERTEX, k, -1), int(on_lines[k])) for k in order]
     lines = []
     for a, b in zip(order, [*order[1:], order[0]], strict=True):
-        lines.append(("t", a) if (a + 1) % 3 == b else ("t", b))
+        shared = int(on_lines[a] & on_lines[b])
+        if shared:
+            lines.append(("s", int(_LOWEST_BIT[shared])))
+        else:
+            lines.append(("t", a) if (a + 1) % 3 == b else ("t", b))
     for edge in range(3):
         if not poly:
             break
-        out: list[tuple[np.ndarray, tuple[int, int, int]]] = []
+        out: list[tuple[np.ndarray, tuple[int, int, int], int]] = []
         out_lines: list[tuple[str, int]] = []
         count = len(poly)
+        a, b, c = STRIKER_EDGES[edge]
+        sign = -1.0 if edge == 1 else 1.0
         for v in range(count):
-            (p, prov_p), (q, _) = poly[v], poly[(v + 1) % count]
+            (p, _, on_p), (q, _, on_q) = poly[v], poly[(v + 1) % count]
             line = lines[v]
-            fp, fq = _inside(p, edge), _inside(q, edge)
-            if fp >= -CLIP_TOL:
-                out.append((p, prov_p))
-                if fq >= -CLIP_TOL:
+            fp = 0.0 if on_p >> edge & 1 else sign * (a * p[0] + b * p[1] - c)
+            fq = 0.0 if on_q >> edge & 1 else sign * (a * q[0] + b * q[1] - c)
+            strict_p = fp >= 0.0 and not on_p >> edge & 1
+            strict_q = fq >= 0.0 and not on_q >> edge & 1
+            if fp >= 0.0:
+                out.append(poly[v])
+                if fq >= 0.0:
                     out_lines.append(line)
                     continue
-                if fp >= 0.0:
+                if strict_p:
                     out_lines.append(line)
-                    x = _crossing(p, q, edge)
-                    out.append((x, _crossing_provenance(line, edge)))
-                # a vertex inside only by the tolerance is its own exit point
+                    out.append(_crossing_vertex(p, q, line, edge))
+                # a vertex on the edge is its own exit point
                 out_lines.append(("s", edge))
-            elif fq >= 0.0:
-                x = _crossing(p, q, edge)
-                out.append((x, _crossing_provenance(line, edge)))
+            elif strict_q:
+                out.append(_crossing_vertex(p, q, line, edge))
                 out_lines.append(line)
-            # entering at a vertex inside only by the tolerance: that vertex is the entry
+            # entering at a vertex on the edge: that vertex
         poly, lines = out, out_lines
-    return _without_repeats(poly)
+    return _merged([(x, prov) for x, prov, _ in poly], lines)
+
+
+def _crossing_vertex(p: np.ndarray, q: np.ndarray, line: tuple[str, int],
+                     edge: int) -> tuple[np.ndarray, tuple[int, int, int], int]:
+    """The polygon vertex where its edge p-q on ``line`` crosses the striker's edge ``edge``."""
+    prov = _crossing_provenance(line, edge)
+    if prov[0] == STRIKER_VERTEX:
+        return REFERENCE[prov[1]].copy(), prov, (1 << edge) | (1 << line[1])
+    return _crossing(p, q, edge), prov, 1 << edge
 
 
 def _crossing_provenance(line: tuple[str, int], edge: int) -> tuple[int, int, int]:
@@ -193,29 +286,81 @@ def _crossing_provenance(line: tuple[str, int], edge: int) -> tuple[int, int, in
     return (STRIKER_VERTEX, shared[frozenset((k, edge))], -1)
 
 
-def _without_repeats(poly):
-    """Drop consecutive vertices closer than round-off (a vertex exactly on an edge)."""
-    kept = []
-    for x, prov in poly:
-        if kept and np.linalg.norm(x - kept[-1][0]) < 1e-13:
-            continue
-        kept.append((x, prov))
-    while len(kept) > 1 and np.linalg.norm(kept[0][0] - kept[-1][0]) < 1e-13:
-        kept.pop()
-    return kept
+#: Consecutive polygon vertices closer than this (in xi) are one corner.
+REPEAT_TOL = 1e-13
+
+
+def _meeting(first: tuple[str, int], second: tuple[str, int]) -> tuple[int, int, int] | None:
+    """Provenance of the point where two lines of a polygon's edges meet (None: one line)."""
+    if first == second:
+        return None
+    if first[0] == "s" and second[0] == "s":
+        return (STRIKER_VERTEX, int(_SHARED[first[1], second[1]]), -1)
+    if first[0] != second[0]:
+        edge, k = (first[1], second[1]) if first[0] == "s" else (second[1], first[1])
+        return (EDGE_CROSSING, edge, k)
+    # two target edges meet at the target vertex they share
+    (vertex,) = {first[1], (first[1] + 1) % 3} & {second[1], (second[1] + 1) % 3}
+    return (TARGET_VERTEX, vertex, -1)
+
+
+def _merged(poly: list, lines: list) -> list:
+    """The clipped polygon with its zero-length edges and flat vertices removed.
+
+    ``poly``: the vertices (xi, provenance); ``lines``: the line of each edge
+    (from a vertex to the next, see :func:`clip`). Two consecutive vertices
+    closer than REPEAT_TOL (a target edge through a striker corner, a vertex
+    on an edge) become one, where the lines of the edges before and after
+    them meet, so that the corner moves as those lines do (keeping either of
+    the two would move the corner along the vanished edge's line, a wrong
+    derivative although the right value); when both are one line the two
+    vertices go. A vertex whose two edges lie on one line goes too.
+    """
+    poly, lines = list(poly), list(lines)
+    changed = True
+    while changed and len(poly) >= 3:
+        changed = False
+        n = len(poly)
+        for m in range(n):
+            after = (m + 1) % n
+            if lines[m - 1] == lines[m]:  # a flat vertex
+                del poly[m], lines[m]
+                changed = True
+                break
+            step = poly[after][0] - poly[m][0]
+            if np.sqrt(step[0] * step[0] + step[1] * step[1]) >= REPEAT_TOL:
+                continue
+            meeting = _meeting(lines[m - 1], lines[after])
+            if meeting is None:  # both vertices lie on the line before and after them
+                for index in sorted((m, after), reverse=True):
+                    del poly[index], lines[index]
+            else:
+                x = REFERENCE[meeting[1]].copy() if meeting[0] == STRIKER_VERTEX else poly[m][0]
+                poly[m] = (x, meeting)
+                lines[m] = lines[after]
+                del poly[after], lines[after]
+            changed = True
+            break
+    if not poly:
+        return poly
+    # the fan starts at the corner of least provenance: the same segments for the same polygon
+    first = min(range(len(poly)), key=lambda v: poly[v][1])
+    return poly[first:] + poly[:first]
 
 
 def corner_from_provenance(kind: int, index: tuple[int, int], striker: np.ndarray,
-                           target: np.ndarray) -> np.ndarray:
+                           target: np.ndarray, snap: np.ndarray | None = None) -> np.ndarray:
     """The xi of a segment corner rebuilt from the current vertex positions (3, 3) each.
 
     The formulas a UFL expression of the segment corners would hold: a fixed
     corner, a projected target vertex, or the crossing of a striker edge with
-    a projected target edge.
+    a projected target edge, the target vertices moved as the snap codes
+    ``snap`` (3,) say (by default those of the positions given).
     """
     if kind == STRIKER_VERTEX:
         return REFERENCE[index[0]].copy()
     projected = local_coordinates(striker, target)
+    projected = snapped(projected, snap_codes(projected) if snap is None else snap)
     if kind == TARGET_VERTEX:
         return projected[index[0]]
     edge, k = index
@@ -298,10 +443,11 @@ def segment_pairs_loop(striker: np.ndarray, target: np.ndarray, s_idx: np.ndarra
                        t_idx: np.ndarray) -> Segments:
     """:func:`segment_pairs` pair by pair with :func:`segment_pair` (the reference)."""
     striker, target = np.asarray(striker, float), np.asarray(target, float)
-    rows: list[tuple[int, int, np.ndarray, tuple]] = []
+    rows: list[tuple[int, int, np.ndarray, tuple, np.ndarray]] = []
     for s, t in zip(s_idx, t_idx, strict=True):
+        codes = snap_codes(local_coordinates(striker[s], target[t]))
         for xi, prov in segment_pair(striker[s], target[t]):
-            rows.append((int(s), int(t), xi, prov))
+            rows.append((int(s), int(t), xi, prov, codes))
     if not rows:
         return _no_segments()
     return Segments(
@@ -310,13 +456,14 @@ def segment_pairs_loop(striker: np.ndarray, target: np.ndarray, s_idx: np.ndarra
         xi=np.array([r[2] for r in rows]),
         kind=np.array([[p[0] for p in r[3]] for r in rows], np.int64),
         index=np.array([[[p[1], p[2]] for p in r[3]] for r in rows], np.int64),
+        snap=np.array([r[4] for r in rows], np.int64),
     )
 
 
 def _no_segments() -> Segments:
     empty = np.zeros(0, np.int64)
     return Segments(empty, empty, np.zeros((0, 3, 2)), np.zeros((0, 3), np.int64),
-                    np.zeros((0, 3, 2), np.int64))
+                    np.zeros((0, 3, 2), np.int64), np.zeros((0, 3), np.int64))
 
 
 #: The corner two striker edges share: _SHARED[i, j] for edges i != j.
@@ -343,9 +490,11 @@ def segment_pairs(striker: np.ndarray, target: np.ndarray, s_idx: np.ndarray,
     s_idx, t_idx, tri_s, tri_t = s_idx[facing], t_idx[facing], tri_s[facing], tri_t[facing]
     if not s_idx.size:
         return _no_segments()
-    alive, x, prov, count = _clip_all(_local_coordinates_all(tri_s, tri_t))
-    s_idx, t_idx = s_idx[alive], t_idx[alive]
-    x, prov, count = _without_repeats_all(x, prov, count)
+    projected = _local_coordinates_all(tri_s, tri_t)
+    codes = snap_codes(projected)
+    alive, x, prov, count, line_kind, line_index = _clip_all(projected, codes)
+    s_idx, t_idx, codes = s_idx[alive], t_idx[alive], codes[alive]
+    x, prov, count = _merged_all(x, prov, count, line_kind, line_index)
     # fan from vertex 0: triangles (0, k, k + 1), k = 1 .. count - 2
     width = x.shape[1]
     if width < 3:
@@ -364,6 +513,7 @@ def segment_pairs(striker: np.ndarray, target: np.ndarray, s_idx: np.ndarray,
         xi=x[pair[:, None], corners],
         kind=provenance[..., 0],
         index=provenance[..., 1:],
+        snap=codes[pair],
     )
 
 
@@ -386,25 +536,32 @@ def _edge_value(x: np.ndarray, edge: int) -> np.ndarray:
     return a * x[..., 0] + b * x[..., 1] - c
 
 
-def _clip_all(tri: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`clip` (before removing repeats) of projected target triangles (p, 3, 2).
+def _clip_all(tri: np.ndarray, codes: np.ndarray) -> tuple[np.ndarray, ...]:
+    """:func:`clip` (before :func:`_merged`) of projected target triangles (p, 3, 2).
 
-    Returns the pairs whose polygon is not empty (k,), their polygons'
-    vertices (k, w, 2), their provenance (k, w, 3) and the vertex counts (k,);
-    slots past a polygon's count hold zeros.
+    ``codes`` (p, 3): their vertices' snap codes (:func:`snap_codes`). Returns
+    the pairs whose polygon is not empty (k,), their polygons' vertices (k, w, 2),
+    their provenance (k, w, 3), the vertex counts (k,) and the line of each
+    edge (from a vertex to the next): its kind (_ON_TARGET, _ON_STRIKER) and
+    index (k, w) each; slots past a polygon's count hold zeros.
     """
     n_pairs = tri.shape[0]
     rows = np.arange(n_pairs)[:, None]
     e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
     positive = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0] > 0
     # counter-clockwise vertex order; each polygon edge (from a vertex to the next) lies
-    # on a line: the target edge line_index (line_kind _ON_TARGET) or a striker edge
+    # on a line: the target edge line_index (line_kind _ON_TARGET) or a striker edge;
+    # each vertex on the striker edges of the bit mask ``on``
     order = np.where(positive[:, None], np.array([0, 1, 2]), np.array([0, 2, 1]))
-    x = tri[rows, order]
+    x = snapped(tri, codes)[rows, order]
+    on = _ON_LINES[codes + 1][rows, order]
     prov = np.stack([np.full((n_pairs, 3), TARGET_VERTEX), order,
                      np.full((n_pairs, 3), -1)], axis=-1)
-    line_kind = np.full((n_pairs, 3), _ON_TARGET)
-    line_index = np.where(positive[:, None], np.array([0, 1, 2]), np.array([2, 1, 0]))
+    # a target edge whose two ends are on one striker edge's line is that edge
+    shared = on & np.roll(on, -1, axis=1)
+    line_kind = np.where(shared > 0, _ON_STRIKER, _ON_TARGET)
+    line_index = np.where(shared > 0, _LOWEST_BIT[shared],
+                          np.where(positive[:, None], np.array([0, 1, 2]), np.array([2, 1, 0])))
     count = np.full(n_pairs, 3)
     alive = np.arange(n_pairs)
     for edge in range(3):
@@ -415,13 +572,14 @@ def _clip_all(tri: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.n
         slot = np.arange(width)[None, :]
         valid = slot < count[:, None]
         following = np.where(slot + 1 < count[:, None], slot + 1, 0)
-        f = _edge_value(x, edge)
+        on_line = (on >> edge & 1).astype(bool)
+        f = np.where(on_line, 0.0, _edge_value(x, edge))
         signed = -f if edge == 1 else f
-        inside, strict = signed >= -CLIP_TOL, signed >= 0.0
+        inside, strict = signed >= 0.0, (signed >= 0.0) & ~on_line
         inside_p = valid & inside
         inside_q, strict_q = inside[rows, following], strict[rows, following]
         leaving = inside_p & ~inside_q
-        # a vertex inside only by the tolerance is its own exit or entry point (_crossing)
+        # a vertex on the edge is its own exit or entry point (_crossing)
         crosses = (leaving & strict) | (valid & ~inside_p & inside_q & strict_q)
         own_exit = leaving & ~strict
         # each vertex p gives p when inside, then the crossing of its edge p-q with the
@@ -435,10 +593,12 @@ def _clip_all(tri: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.n
         new_prov = np.zeros((n_pairs, new_width, 3), np.int64)
         new_kind = np.zeros((n_pairs, new_width), np.int64)
         new_index = np.zeros((n_pairs, new_width), np.int64)
+        new_on = np.zeros((n_pairs, new_width), np.int64)
         pair, at = np.nonzero(inside_p)
         to = start[pair, at]
         new_x[pair, to] = x[pair, at]
         new_prov[pair, to] = prov[pair, at]
+        new_on[pair, to] = on[pair, at]
         exit_here = own_exit[pair, at]
         new_kind[pair, to] = np.where(exit_here, _ON_STRIKER, line_kind[pair, at])
         new_index[pair, to] = np.where(exit_here, edge, line_index[pair, at])
@@ -451,51 +611,62 @@ def _clip_all(tri: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.n
         k = line_index[pair, at]
         after_p = inside_p[pair, at]
         to = start[pair, at] + after_p
-        new_x[pair, to] = p + t[:, None] * (q - p)
+        corner = _SHARED[k, edge]
+        # two striker edges cross at the corner they share, exactly
+        new_x[pair, to] = np.where(on_target[:, None], p + t[:, None] * (q - p),
+                                   REFERENCE[np.where(on_target, 0, corner)])
         new_prov[pair, to] = np.stack([
             np.where(on_target, EDGE_CROSSING, STRIKER_VERTEX),
-            np.where(on_target, edge, _SHARED[k, edge]),
+            np.where(on_target, edge, corner),
             np.where(on_target, k, -1)], axis=-1)
+        new_on[pair, to] = np.where(on_target, 1 << edge, (1 << edge) | (1 << k))
         # leaving the striker, the polygon goes on along the striker's edge
         new_kind[pair, to] = np.where(after_p, _ON_STRIKER, line_kind[pair, at])
         new_index[pair, to] = np.where(after_p, edge, k)
         # drop the polygons clipped away
         kept = count > 0
         alive, count = alive[kept], count[kept]
-        x, prov = new_x[kept], new_prov[kept]
+        x, prov, on = new_x[kept], new_prov[kept], new_on[kept]
         line_kind, line_index = new_kind[kept], new_index[kept]
-    return alive, x, prov, count
+    return alive, x, prov, count, line_kind, line_index
 
 
-def _without_repeats_all(x: np.ndarray, prov: np.ndarray,
-                         count: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`_without_repeats` of polygons (p, w, 2) with provenance (p, w, 3) and counts (p,)."""
+def _merged_all(x: np.ndarray, prov: np.ndarray, count: np.ndarray, line_kind: np.ndarray,
+                line_index: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_merged` of polygons (p, w, 2), provenance (p, w, 3), counts (p,), edge lines.
+
+    Only the polygons with a short edge or two consecutive edges on one line
+    (degenerate contact: a few) go through :func:`_merged`, one at a time.
+    """
     n_pairs, width = x.shape[:2]
-    rows = np.arange(n_pairs)
-    kept = np.zeros((n_pairs, width), bool)
-    last = np.zeros(n_pairs, np.int64)  # the last kept vertex (when there is one)
-    for slot in range(width):
-        step = x[:, slot] - x[rows, last]
-        close = np.sqrt(step[:, 0] * step[:, 0] + step[:, 1] * step[:, 1]) < 1e-13
-        keep = (slot < count) & ~(close & kept.any(axis=1))
-        kept[:, slot] = keep
-        last = np.where(keep, slot, last)
-    # then drop trailing vertices that repeat the first one
-    n_kept = kept.sum(axis=1)
-    position = np.cumsum(kept, axis=1) - 1
-    pair, slot = np.nonzero(kept)
-    new_x = np.zeros((n_pairs, width, 2))
-    new_prov = np.zeros((n_pairs, width, 3), np.int64)
-    new_x[pair, position[pair, slot]] = x[pair, slot]
-    new_prov[pair, position[pair, slot]] = prov[pair, slot]
-    for _ in range(width):
-        tail = new_x[rows, np.maximum(n_kept - 1, 0)] - new_x[:, 0]
-        close = np.sqrt(tail[:, 0] * tail[:, 0] + tail[:, 1] * tail[:, 1]) < 1e-13
-        drop = (n_kept > 1) & close
-        if not drop.any():
-            break
-        n_kept = n_kept - drop
-    return new_x, new_prov, n_kept
+    if not n_pairs:
+        return x, prov, count
+    slot = np.arange(width)[None, :]
+    valid = slot < count[:, None]
+    following = np.where(slot + 1 < count[:, None], slot + 1, 0)
+    rows = np.arange(n_pairs)[:, None]
+    step = x[rows, following] - x
+    short = np.sqrt(step[..., 0] * step[..., 0] + step[..., 1] * step[..., 1]) < REPEAT_TOL
+    same = ((line_kind[rows, following] == line_kind)
+            & (line_index[rows, following] == line_index))
+    flagged = np.flatnonzero(np.any(valid & (short | same), axis=1) & (count >= 3))
+    x, prov, count = x.copy(), prov.copy(), count.copy()
+    for pair in flagged:
+        n = int(count[pair])
+        poly = [(x[pair, v].copy(), tuple(int(i) for i in prov[pair, v])) for v in range(n)]
+        lines = [("s" if line_kind[pair, v] == _ON_STRIKER else "t", int(line_index[pair, v]))
+                 for v in range(n)]
+        kept = _merged(poly, lines)
+        count[pair] = len(kept)
+        for v, (xv, pv) in enumerate(kept):
+            x[pair, v], prov[pair, v] = xv, pv
+    # the fan starts at the corner of least provenance (as _merged)
+    key = (prov[..., 0] * 16 + prov[..., 1]) * 16 + prov[..., 2] + 1
+    slot = np.arange(width)[None, :]
+    first = np.argmin(np.where(slot < count[:, None], key, np.iinfo(np.int64).max), axis=1)
+    order = np.where(slot < count[:, None],
+                     (slot + first[:, None]) % np.maximum(count, 1)[:, None], slot)
+    return x[rows, order], prov[rows, order], count
 
 
 def _largest_size(tris: np.ndarray) -> float:
@@ -558,6 +729,8 @@ __all__ = [
     "segment_pairs",
     "segment_pairs_loop",
     "segment_surfaces",
+    "snap_codes",
+    "snapped",
     "unit_normal",
     "weighted_gaps",
 ]
