@@ -90,6 +90,7 @@ def main() -> None:
         call([PYTHON, str(HERE / "validation" / "mortar_hertz.py")])
         call([PYTHON, str(HERE / "validation" / "mortar_hertz.py"), "--swap"])
         call([PYTHON, str(HERE / "validation" / "striker_choice.py")])
+        call([PYTHON, str(HERE / "validation" / "bridge_rim.py")])
     if "hertz3d" in parts:
         call([PYTHON, str(HERE / "validation" / "hertz3d.py")])
     for dofs, solver, ranks, repeats in LADDER:

@@ -7,16 +7,16 @@
 // Physical groups:
 //   Surface "left_support" = 1, "right_support" = 2, "bridge" = 3     (cell tags)
 //   Curve "left_base" = 1, "right_base" = 2, "left_top" = 3, "right_top" = 4,
-//   "bridge_under_left" = 5, "bridge_under_right" = 6: the bridge's underside over
-//   each support, x in [0.5, 1] and [2, 2.5]; with whole_underside = 1 each runs
-//   on over the gap to the middle, x in [0.5, 1.5] and [1.5, 2.5] (a striker
-//   that reaches past its target), "bridge_top" = 9                 (facet tags)
+//   "bridge_under_left" = 5, "bridge_under_right" = 6: the halves of the bridge's
+//   underside, x in [0.5, 1.5] and [1.5, 2.5], each running on past its support
+//   over the gap; with whole_underside = 0 only the parts over the supports,
+//   x in [0.5, 1] and [2, 2.5], "bridge_top" = 9                     (facet tags)
 DefineConstant[
   H = {0.5, Name "Parameters/support_height"},
   T = {0.3, Name "Parameters/bridge_thickness"},
   hs = {0.1, Name "Parameters/h_support"},
   hb = {0.05, Name "Parameters/h_bridge"},
-  whole_underside = {0, Name "Parameters/whole_underside"}
+  whole_underside = {1, Name "Parameters/whole_underside"}
 ];
 Geometry.AutoCoherence = 0;
 Point(1) = {0, 0, 0, hs}; Point(2) = {1, 0, 0, hs}; Point(3) = {1, H, 0, hs}; Point(4) = {0, H, 0, hs};

@@ -88,3 +88,12 @@ def test_misuse_is_named():
         ContactSettings(r="10")
     with pytest.raises(TypeError, match="one entry per component"):
         PrescribedDisplacement(np.arange(3, dtype=np.int32), -0.01)
+
+
+def test_a_free_component_is_spelt_as_in_scenes_too():
+    """'free' (the scene's word) and None both leave a component free; other words are refused."""
+    facets = np.arange(3, dtype=np.int32)
+    assert PrescribedDisplacement(facets, ("free", -0.01)).value == (None, -0.01)
+    assert PrescribedDisplacement(facets, [" Free", 0.0, None]).at(0.5) == (None, 0.0, None)
+    with pytest.raises(ValueError, match=r"'fixed' is neither a number nor free"):
+        PrescribedDisplacement(facets, ("fixed", 0.0))

@@ -4,10 +4,11 @@ Past a free side of the target (its end vertex in 2D, an edge of the patch's
 rim in 3D) the plane of the last facet extends over nothing. A striker node
 farther than a quarter of its facet size past the rim is lifted to its
 distance from the target, so it stays open. ``scenes/bridge.toml``: a bridge
-across two supports; with the whole underside striking (the mesh parameter
-``whole_underside = 1``) the force is that of the strikers tagged over the
-supports only, and that of automatic pairing. Held level with the supports,
-as before the rule, it came out 21 % high.
+across two supports, each pair striking with a whole half of the underside.
+On the shipped mesh no striker node lies within that quarter facet of a
+rim, and the force is that of the strikers tagged over the supports only
+(``whole_underside = 0``) and of automatic pairing. Held level with the
+supports, as before the rule, it came out 21 % high.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ import pytest
 from mpi4py import MPI
 
 from fenics_contact import load_scene, run_scene
-from fenics_contact.model.search import past_free_edge
+from fenics_contact.model.search import past_free_edge, penetration_depth
 from fenics_contact.model.target_surface import free_sides
 
 ROOT = Path(__file__).parents[1]
@@ -67,6 +68,11 @@ def test_points_past_the_rim_of_a_flat_patch():
     past = past_free_edge(points, vertices, free, reach=0.1)
     assert past.tolist() == [False, False, True, True, True, False]
     assert past_free_edge(points[-1:], vertices, free, reach=0.01).tolist() == [True]
+    # past the corner (1, 1), shared by both triangles, a little below the plane: not
+    # inside the surface (the pseudo-normal of the corner alone said 0.28 deep)
+    beyond = np.array([[1.2, 1.2, -0.01], [0.2, 0.1, -0.01]])
+    assert penetration_depth(beyond, vertices).tolist()[0] > 0.28
+    assert penetration_depth(beyond, vertices, free=free) == pytest.approx([0.0, 0.01])
 
 
 def test_points_past_the_end_of_a_polyline():
@@ -100,14 +106,14 @@ def _run(tmp_path: Path, name: str, text: str) -> tuple[dict, object]:
 @pytest.mark.mpi
 def test_a_striker_past_its_target_opens_there(tmp_path_factory):
     tmp_path = _shared_dir(tmp_path_factory)
-    over, _ = _run(tmp_path, "over", TEXT)
+    over_text = TEXT.replace('file = "', 'parameters = { whole_underside = 0 }\nfile = "')
+    over, _ = _run(tmp_path, "over", over_text)
     reactions = over["reactions"]
     load = -reactions["bridge_top"][1]
     assert sum(r[1] for r in reactions.values()) == pytest.approx(0.0, abs=1e-12 * load)
     # two equal supports: each carries half the load (the meshes are not mirrored)
     assert reactions["left_base"][1] == pytest.approx(load / 2, rel=0.01)
-    whole_text = TEXT.replace('file = "', 'parameters = { whole_underside = 1 }\nfile = "')
-    whole, outcome = _run(tmp_path, "whole", whole_text)
+    whole, outcome = _run(tmp_path, "whole", TEXT)
     # before the rim rule: 0.36745 against 0.30328 (+21 %)
     assert whole["contact_force"] == pytest.approx(over["contact_force"], rel=1e-8)
     automatic = TEXT[:TEXT.index("[[pair]]")] + "[pairing]\nautomatic = true\n\n" + \

@@ -46,7 +46,7 @@ class PrescribedDisplacement:
     Attributes:
         facets: facet indices (local) where the condition holds.
         value: final displacement per component (length units); ``None``
-            leaves that component free.
+            (or ``"free"``, as scenes write it) leaves that component free.
         name: the support's name in the reports (the scene's tag); conditions
             of one name make one support.
     """
@@ -62,6 +62,13 @@ class PrescribedDisplacement:
         if not isinstance(self.facets, np.ndarray | list | tuple):
             raise TypeError(f"facets: give an array of facet indices, not "
                             f"{type(self.facets).__name__} (a MeshTags: tags.find(value)).")
+        value = tuple(None if isinstance(v, str) and v.strip().lower() == "free" else v
+                      for v in self.value)
+        for v in value:
+            if isinstance(v, str):
+                raise ValueError(f"value = {self.value!r}: {v!r} is neither a number nor free; "
+                                 "give a displacement (length) or None (or 'free').")
+        object.__setattr__(self, "value", value)
 
     def at(self, t: float) -> tuple[float | None, ...]:
         """Displacement per component at load factor t (None: free)."""
