@@ -22,6 +22,7 @@ from fenics_contact.output.folders import agree, write_failure
 from fenics_contact.output.io import write_json
 from fenics_contact.output.paraview import SCRIPT, write_paraview_script
 from fenics_contact.output.xdmf import StepWriter, finished_steps, step_files
+from fenics_contact.scene.body_overlap import warn_body_overlap
 from fenics_contact.scene.build import build_problem
 from fenics_contact.scene.checks import warn_untagged_penetration
 from fenics_contact.scene.schema import Scene
@@ -308,6 +309,7 @@ def run_scene(
         path.steps[-1].reactions = problem.support_reactions()
     summary = _write_summary(comm, out, scene, path, used)
     warn_untagged_penetration(scene, problem)
+    warn_body_overlap(scene, problem)
     advise_striker(scene, problem)
     if not finished_steps(out / "solution.xdmf"):  # no step on disk: nothing to open
         if comm.rank == 0:

@@ -27,7 +27,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
 import fenics_contact  # noqa: F401  (the DOLFINx wheel first)
-from benchmarks.harness import md_table, write
+from benchmarks.harness import machine, md_table, write
 from fenics_contact import build_problem, load_scene, scene_strategy, solve_load_path
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -62,7 +62,8 @@ def main() -> None:
     rows = [[r["h_bridge"], r["striker"], r["discretisation"], r["iterations"],
              f"{r['load']:.6f}", r["status"]] for r in runs]
     table = md_table(("h bridge", "striker", "pair", "Newton", "load", "status"), rows)
-    write("bridge_rim", {"scene": str(SCENE.relative_to(ROOT)), "runs": runs}, table, args.out)
+    write("bridge_rim", {"machine": machine(), "scene": str(SCENE.relative_to(ROOT)),
+                         "runs": runs}, table, args.out)
     print(table)
 
 

@@ -105,3 +105,30 @@ def tube_crush_figure(data: dict) -> Figure:
     ax.legend(fontsize=7)
     fig.tight_layout()
     return fig
+
+
+def bridge_rim_table(data: dict) -> Rows:
+    """Per mesh, striker and pair: Newton iterations and the load the bridge carries."""
+    header = ["h bridge", "striker", "pair", "Newton", "load", "status"]
+    rows = [[r["h_bridge"], r["striker"], r["discretisation"], r["iterations"], r["load"],
+             r["status"]] for r in data["runs"]]
+    return header, rows
+
+
+def bridge_rim_figure(data: dict) -> Figure:
+    """The load against the bridge's facet size, for each striker and pair."""
+    fig, ax = plt.subplots(figsize=(6.5, 3.8))
+    styles = {("whole underside", "mortar"): "o-", ("whole underside", "node-to-segment"): "s-",
+              ("over the supports", "mortar"): "o--",
+              ("over the supports", "node-to-segment"): "s--"}
+    for (striker, pair), style in styles.items():
+        runs = [r for r in data["runs"] if r["striker"] == striker
+                and r["discretisation"] == pair]
+        ax.semilogx([r["h_bridge"] for r in runs], [r["load"] for r in runs], style,
+                    mfc="none", label=f"{pair}, {striker}")
+    ax.set_xlabel("bridge facet size h")
+    ax.set_ylabel("load carried (per unit length)")
+    ax.set_title("A bridge across two supports")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    return fig

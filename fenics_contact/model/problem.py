@@ -315,7 +315,8 @@ class ContactProblem(FrictionalContacts):
         """
         suffix = "_friction" if self.frictional else ""
         return energy_system(name + suffix, energy, self.u, self.bcs, self.contacts,
-                             with_lam=with_lam, tangential=tangential)
+                             with_lam=with_lam, tangential=tangential,
+                             supports=self.solid.record_support_residual)
 
     def augmented_system(self) -> VariationalSystem:
         """Alart-Curnier saddle point on (u, lam[, lam_t]): the GNRM system.

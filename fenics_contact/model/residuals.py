@@ -53,6 +53,7 @@ def energy_system(
     *,
     with_lam: bool,
     tangential: Callable | None = None,
+    supports: Callable | None = None,
 ) -> VariationalSystem:
     """Residual blocks from an energy plus the friction work.
 
@@ -88,7 +89,8 @@ def energy_system(
     if extras:
         transfer = transfers[0] if len(transfers) == 1 else Transfers(transfers)
     return VariationalSystem(name, residuals, unknowns, bcs, contact_entity_maps(contacts),
-                             extras=extras, transfer=transfer, jit_options=jit_options(contacts))
+                             extras=extras, transfer=transfer, jit_options=jit_options(contacts),
+                             supports=supports)
 
 
 def complementarity_forms(contacts: Sequence[Contact]) -> list[ufl.Form]:

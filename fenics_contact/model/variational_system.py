@@ -42,6 +42,10 @@ class VariationalSystem:
     #: Options of the forms' just-in-time compilation (None: the defaults); a contact
     #: with very large kernels asks for cheaper C optimisation (see :func:`jit_options`).
     jit_options: dict | None = None
+    #: Called by a condensing solver at each residual with (owned u dofs of the Dirichlet
+    #: rows, the condensed residual there before the rows are set): the supports' forces
+    #: on the bodies, contact at a held node included (:meth:`Solid.support_reactions`).
+    supports: Callable[[np.ndarray, np.ndarray], None] | None = None
 
 
 def jit_options(contacts: Sequence[object]) -> dict | None:

@@ -316,6 +316,8 @@ class CondensedKernel(NewtonKernel):
             self.P.multTranspose(b, self.b)
             self._boundary_values()
             arr = self.b.getArray()
+            if self.system.supports is not None:  # the supports' forces, contact included
+                self.system.supports(self._bc_local, arr[self._bc_local].copy())
             arr[self._bc_local] = self.z.getArray(readonly=True)[self._bc_local]
             return float(self.b.norm())
 

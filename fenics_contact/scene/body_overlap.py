@@ -1,0 +1,134 @@
+"""After a run: boundary nodes of one body of a pair found inside the other body.
+
+A node-to-segment pair holds its striker nodes out of the target surface,
+one way only: the target's nodes, and the nodes of either body outside its
+tagged surface, are not held. Where they end up inside the partner body (a
+target corner pressing into the striker's facets, a striker tagged short of
+where its partner reaches), the answer is wrong without a failure. A mortar
+pair constrains weighted gaps: single nodes at the edge of a contact zone
+may lie inside by a few per cent of h (2.3 % on the ironing scene). At the
+end of a run each pair's two bodies are checked both ways: every boundary
+node of one against the whole boundary of the other (a closed surface: the
+pseudo-normal at the closest point tells inside from outside), and one
+warning per pair names the deepest node when it lies deeper than
+:data:`WARN_DEPTH` (node-to-segment) or :data:`WARN_DEPTH_MORTAR` striker
+facet sizes. A self-contact pair of two surfaces of one body is checked one
+way, the target's nodes against the striker surface (open, with its rim).
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import TYPE_CHECKING
+
+import numpy as np
+from dolfinx import fem, mesh
+
+from mpi4py import MPI
+
+from fenics_contact.model.mortar import MortarContact
+from fenics_contact.model.search import penetration_depth
+from fenics_contact.model.segments import Polyline
+from fenics_contact.model.target_surface import free_sides
+
+if TYPE_CHECKING:
+    from fenics_contact.model.body import Body
+    from fenics_contact.model.problem import ContactProblem
+    from fenics_contact.scene.schema import Scene
+
+#: A boundary node deeper than this many striker facet sizes inside the partner is named.
+WARN_DEPTH = 1e-2
+#: The same for a mortar pair, whose weighted gaps let single nodes in a little.
+WARN_DEPTH_MORTAR = 5e-2
+
+
+def _boundary_facets(problem: ContactProblem, body: Body) -> np.ndarray:
+    """Owned exterior facets of ``body``'s cells (local indices)."""
+    domain = problem.domain
+    tdim = domain.topology.dim
+    domain.topology.create_connectivity(tdim - 1, tdim)
+    facets = mesh.exterior_facet_indices(domain.topology)
+    tags = problem.solid.cell_tags
+    if body.tag is None or tags is None:
+        return facets
+    cell_tag = np.full(domain.topology.index_map(tdim).size_local
+                       + domain.topology.index_map(tdim).num_ghosts, -1, np.int64)
+    cell_tag[tags.indices] = tags.values
+    f2c = domain.topology.connectivity(tdim - 1, tdim)
+    cells = np.array([f2c.links(f)[0] for f in facets], np.int64)
+    return facets[cell_tag[cells] == body.tag] if facets.size else facets
+
+
+def _inside(problem: ContactProblem, facets: np.ndarray,
+            surface_facets: np.ndarray) -> tuple[float, np.ndarray]:
+    """(depth, position) of the deepest owned node of ``facets`` behind ``surface_facets``."""
+    V, u = problem.V, problem.u
+    gdim = problem.domain.geometry.dim
+    surface = Polyline(V, surface_facets, dim=gdim)
+    vertices = (surface.X + surface.displacements(u))[surface.facet_vertex]
+    blocks = fem.locate_dofs_topological(V, problem.domain.topology.dim - 1, facets)
+    blocks = blocks[blocks < V.dofmap.index_map.size_local]
+    points = V.tabulate_dof_coordinates()[blocks, :gdim] + u.x.array.reshape(-1, gdim)[blocks]
+    lo, hi = vertices.reshape(-1, gdim).min(axis=0), vertices.reshape(-1, gdim).max(axis=0)
+    near = np.all((points >= lo) & (points <= hi), axis=1)
+    if not np.any(near):
+        return 0.0, np.zeros(gdim)
+    depth = penetration_depth(points[near], vertices,
+                              free=free_sides(surface.blocks, MPI.COMM_SELF))
+    worst = int(np.argmax(depth))
+    return float(depth[worst]), points[near][worst]
+
+
+def warn_body_overlap(scene: Scene, problem: ContactProblem) -> float:
+    """Warn per two-body pair whose bodies overlap; return the deepest depth / h (collective)."""
+    from fenics_contact.scene.checks import SceneWarning
+
+    comm, deepest = problem.comm, 0.0
+    gdim = problem.domain.geometry.dim
+    for contact in problem.contacts:
+        striker, target = getattr(contact, "striker_body", None), getattr(contact, "target_body",
+                                                                          None)
+        if striker is None or target is None:
+            continue
+        if striker is target:  # self-contact: the target's nodes against the striker surface
+            one = np.array_equal(contact.facets, contact.target_facets)
+            if comm.allreduce(one, op=MPI.LAND):
+                continue  # one surface: every node is a striker node
+            found = [_inside(problem, contact.target_facets, contact.facets), (0.0, None)]
+        else:
+            sides = [_boundary_facets(problem, b) for b in (target, striker)]
+            found = [_inside(problem, sides[0], sides[1]), _inside(problem, sides[1], sides[0])]
+        depths = [comm.allreduce(d, op=MPI.MAX) for d, _ in found]
+        which = int(np.argmax(depths))
+        depth, h = depths[which], contact.surface.h
+        deepest = max(deepest, depth / h)
+        mortar = isinstance(contact, MortarContact)
+        if depth <= (WARN_DEPTH_MORTAR if mortar else WARN_DEPTH) * h:
+            continue
+        rank = comm.allreduce((found[which][0], comm.rank), op=MPI.MAXLOC)[1]
+        point = comm.bcast(found[which][1], root=rank)
+        inner, outer = ((target, striker), (striker, target))[which]
+        where = ", ".join(f"{c:.4g}" for c in point[:gdim])
+        what = (f"a node of the target surface lies {depth:.3g} ({depth / h:.1%} of h) behind "
+                "the striker surface" if striker is target else
+                f"a boundary node of body {inner.name!r} lies {depth:.3g} ({depth / h:.1%} of h) "
+                f"inside body {outer.name!r}")
+        if mortar:
+            fix = ("A mortar pair holds weighted gaps, not single nodes: refine both surfaces "
+                   "where they touch, or tag the striker wherever the partner may reach.")
+        elif striker is target:
+            fix = ("The pair holds its striker nodes out of the target only: let the finer "
+                   "surface strike, or tag both surfaces as one and pair it with itself "
+                   "(striker = target: every node is held, though walls that meet node on node "
+                   "may then cycle; docs/contacts.md).")
+        else:
+            fix = ("The pair holds its striker nodes out of the target only: tag the striker "
+                   "wherever the partner may reach, let the finer surface strike, or use "
+                   'discretisation = "mortar".')
+        warnings.warn(SceneWarning(
+            f"{scene.path.name}: [[pair]] {contact.name!r}: {what}, near ({where}). {fix}"),
+            stacklevel=2)
+    return deepest
+
+
+__all__ = ["WARN_DEPTH", "WARN_DEPTH_MORTAR", "warn_body_overlap"]

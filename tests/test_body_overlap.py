@@ -1,0 +1,60 @@
+"""After a run, each two-body pair's bodies are checked both ways for nodes inside the partner.
+
+A node-to-segment pair holds its striker nodes out of the target surface,
+one way: on ``scenes/bridge.toml`` each support's top corner, a target node,
+slides out under the bridge and lies 5.8e-4 (1.2 % of the striker's h)
+inside it, and the run says so. Blocks stacked with their faces meeting whole
+(``scenes/stack_3_blocks.toml``) overlap by round-off: no warning.
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+from pathlib import Path
+
+import pytest
+
+from mpi4py import MPI
+
+from fenics_contact import load_scene, run_scene
+from fenics_contact.scene.body_overlap import WARN_DEPTH, warn_body_overlap
+from fenics_contact.scene.checks import SceneWarning
+
+ROOT = Path(__file__).parents[1]
+
+
+def _shared_dir(factory) -> Path:
+    comm = MPI.COMM_WORLD
+    return Path(comm.bcast(str(factory.mktemp("overlap")) if comm.rank == 0 else None, root=0))
+
+
+@pytest.mark.mpi
+def test_a_target_corner_inside_the_striker_is_named(tmp_path_factory):
+    out = _shared_dir(tmp_path_factory)
+    scene = load_scene(ROOT / "scenes" / "bridge.toml")
+    with pytest.warns(SceneWarning) as seen:
+        outcome = run_scene(scene, out / "bridge", pictures=False)
+    messages = [str(w.message) for w in seen if "inside body" in str(w.message)]
+    assert len(messages) == 2  # one per pair
+    for side, x in (("left", 1.002), ("right", 1.998)):
+        found = [m for m in messages if f"body '{side}' lies" in m]
+        assert len(found) == 1
+        depth = float(re.search(r"lies ([0-9.e-]+) \(", found[0]).group(1))
+        assert depth == pytest.approx(5.8e-4, rel=0.02)
+        assert f"near ({x}, 0.4967)" in found[0]
+        assert "inside body 'bridge'" in found[0]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        deepest = warn_body_overlap(scene, outcome.problem)
+    assert deepest == pytest.approx(0.0116, rel=0.02)  # of h
+    assert deepest > WARN_DEPTH
+
+
+def test_blocks_whose_faces_meet_whole_overlap_by_round_off_only(tmp_path):
+    scene = load_scene(ROOT / "scenes" / "stack_3_blocks.toml")
+    outcome = run_scene(scene, tmp_path / "stack", pictures=False)
+    assert outcome.path.converged
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", SceneWarning)
+        assert warn_body_overlap(scene, outcome.problem) < 1e-12
