@@ -74,6 +74,7 @@ benchmarks: venv
 # The documentation site into docs/_build/html (Sphinx; warnings are errors). The
 # venv gains the `docs` extra; the demos run as notebooks at their CI size.
 docs: $(VENV)/.installed-docs
+	rm -rf docs/_generated/api  # pages of modules that no longer exist would fail the build
 	$(BIN)/sphinx-build -b html -W --keep-going docs docs/_build/html
 	@echo "The site: docs/_build/html/index.html"
 
