@@ -10,7 +10,7 @@ proportional to one load factor ``t`` in [0, 1]. Contacts
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import basix
@@ -377,15 +377,17 @@ class Solid:
             out[i] = vec.array[dofs].sum()
         return self.comm.allreduce(out, op=MPI.SUM)
 
-    def record_support_residual(self, dofs: np.ndarray, values: np.ndarray) -> None:
+    def record_support_residual(self, dofs: np.ndarray,
+                                values: np.ndarray | Callable[[], np.ndarray]) -> None:
         """Keep a solver's residual on the Dirichlet rows (owned u dofs) at the current u.
 
         The whole residual there (strain energy, tractions and every contact,
         the deformable targets' share condensed onto their vertices) is the
         supports' force on the bodies; :meth:`support_reactions` uses it while
-        u is unchanged.
+        u is unchanged. ``values`` may be a function that assembles them when
+        asked (collective).
         """
-        self._support_residual = (np.asarray(dofs), np.asarray(values), self.u.x.array.copy())
+        self._support_residual = (np.asarray(dofs), values, self.u.x.array.copy())
 
     def support_reactions(self) -> dict[str, list[float]]:
         """The force each support exerts on the bodies, per component (force; per thickness in 2D).
@@ -395,16 +397,17 @@ class Solid:
         is the nodal force summed over the displacement components the support
         prescribes (a free component reads 0), each counted once per support;
         a component two supports prescribe at one node counts in both. The
-        nodal force is the whole residual at the current u when a solver with
-        deformable contacts recorded it (:meth:`record_support_residual`: a
-        held node in contact passes its contact force to the support), else
-        the internal force. Over supports that share no prescribed component,
-        the reactions balance the contact forces and the tractions. Collective.
+        nodal force is the whole residual at the current u when a solver
+        recorded it (:meth:`record_support_residual`: a held node in contact
+        passes its contact force to the support), else the internal force.
+        Over supports that share no prescribed component, the reactions
+        balance the contact forces and the tractions. Collective.
         """
         vec = self._internal_force()
         recorded = getattr(self, "_support_residual", None)
         if recorded is not None and np.array_equal(recorded[2], self.u.x.array):
-            vec.array[recorded[0]] = recorded[1]
+            values = recorded[1]() if callable(recorded[1]) else recorded[1]
+            vec.array[recorded[0]] = values
         n_owned = self.V.dofmap.index_map.size_local * self.gdim
         fdim = self.domain.topology.dim - 1
         held: dict[str, list[list[np.ndarray]]] = {}

@@ -16,7 +16,7 @@ import itertools
 import weakref
 
 import numpy as np
-from dolfinx import fem
+from dolfinx import fem, la
 from dolfinx.fem import petsc as fem_petsc
 
 from petsc4py import PETSc
@@ -174,7 +174,31 @@ class NewtonKernel:
             fem_petsc.assemble_residual(
                 None, self.x, self.b, self.unknowns, self.F, self.J, self.bcs, self._blocks
             )
+            if self.system.supports is not None:  # asked for only when a report needs it
+                self.system.supports(self._support_dofs(), self._support_residual)
             return float(self.b.norm())
+
+    def _support_dofs(self) -> np.ndarray:
+        """The owned displacement dofs of the Dirichlet rows (local, unrolled)."""
+        if getattr(self, "_held", None) is None:
+            V = self.unknowns[0].function_space
+            n_u = V.dofmap.index_map.size_local * V.dofmap.index_map_bs
+            held = [bc.dof_indices()[0][: bc.dof_indices()[1]] for bc in self.bcs]
+            held = np.unique(np.concatenate(held)) if held else np.zeros(0, np.int32)
+            self._held = held[held < n_u]
+        return self._held
+
+    def _support_residual(self) -> np.ndarray:
+        """The displacement residual on the Dirichlet rows before they are set (force).
+
+        At a solution the rows hold x = x_D, so the lifting adds nothing there:
+        these are the supports' forces on the bodies, contact at a held node
+        included. One assembly of the displacement block (called on demand).
+        """
+        form = self.F[0] if isinstance(self.F, list | tuple) else self.F
+        vec = fem.assemble_vector(form)
+        vec.scatter_reverse(la.InsertMode.add)
+        return vec.array[self._support_dofs()].copy()
 
     def _assemble_A(self) -> None:
         """Hook: the Jacobian at the current unknowns into A, Dirichlet rows set."""
