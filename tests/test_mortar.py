@@ -299,3 +299,52 @@ def test_stability_grid_mortar_case_at_huge_r() -> None:
     assert record.steps_completed == 3 and record.max_penetration < 1e-8
     assert record.iterations <= 20  # measured 17
     assert abs(record.contact_force - reference.contact_force) <= 1e-6 * reference.contact_force
+
+
+L_BRACKET = """// an L bracket and a block in its inside corner, touching both of its faces
+Geometry.AutoCoherence = 0;
+Point(1) = {0, 0, 0, 0.05}; Point(2) = {1, 0, 0, 0.05}; Point(3) = {1, 0.2, 0, 0.05};
+Point(4) = {0.2, 0.2, 0, 0.05}; Point(5) = {0.2, 1, 0, 0.05}; Point(6) = {0, 1, 0, 0.05};
+Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 5}; Line(5) = {5, 6};
+Line(6) = {6, 1}; Curve Loop(1) = {1, 2, 3, 4, 5, 6}; Plane Surface(1) = {1};
+Point(11) = {0.2, 0.2, 0, 0.04}; Point(12) = {0.6, 0.2, 0, 0.04};
+Point(13) = {0.6, 0.6, 0, 0.04}; Point(14) = {0.2, 0.6, 0, 0.04};
+Line(11) = {11, 12}; Line(12) = {12, 13}; Line(13) = {13, 14}; Line(14) = {14, 11};
+Curve Loop(11) = {11, 12, 13, 14}; Plane Surface(11) = {11};
+Mesh.Algorithm = 6;
+Physical Surface("bracket", 1) = {1}; Physical Surface("block", 2) = {11};
+Physical Curve("base", 1) = {1}; Physical Curve("floor", 2) = {3}; Physical Curve("wall", 3) = {4};
+Physical Curve("block_corner", 4) = {11, 14}; Physical Curve("block_top", 6) = {13};
+"""
+
+
+def test_a_mortar_striker_turning_a_corner(tmp_path) -> None:
+    """A block pushed into the inside corner of an L bracket, its striker the bottom and the
+    side (a corner): each target slot of a corner node serves both of its facets, and the
+    facet that does not face the target gets nothing from it. Before, the perpendicular
+    facet divided by n_s . n_t = 0 and every residual was NaN."""
+    import json
+
+    from fenics_contact.cli import main
+
+    (tmp_path / "bracket.geo").write_text(L_BRACKET)
+    pairs = "".join(f'[[pair]]\nname = "on-{t}"\nstriker = "block_corner"\ntarget = "{t}"\n'
+                    'discretisation = "mortar"\n\n' for t in ("floor", "wall"))
+    (tmp_path / "bracket.toml").write_text(
+        '[scene]\nname = "bracket"\ndimension = 2\n\n[mesh]\nfile = "bracket.geo"\n\n'
+        + "".join(f'[[body]]\nname = "{b}"\ntag = "{b}"\nlaw = "linear"\nE = {e}\nnu = 0.3\n\n'
+                  for b, e in (("bracket", 200.0), ("block", 100.0)))
+        + pairs + '[[dirichlet]]\ntag = "base"\nvalue = [0.0, 0.0]\n\n'
+        '[[dirichlet]]\ntag = "block_top"\nvalue = [-0.02, -0.02]\n\n'
+        '[solver]\nmethod = "gnrm"\nsteps = 4\n')
+    out = tmp_path / "run"
+    assert main(["run", str(tmp_path / "bracket.toml"), "--out", str(out), "--quiet"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "converged"
+    last = summary["steps"][-1]
+    assert sum(s["iterations"] for s in summary["steps"]) <= 12  # measured 9
+    # node-to-segment with the same two pairs: 2.50279 (mortar 2.49862, -0.17 %)
+    assert last["contact_force"] == pytest.approx(2.50279, rel=3e-3)
+    base = last["reactions"]["base"]
+    assert base[0] == pytest.approx(-last["reactions"]["block_top"][0], rel=1e-8)
+    assert base[1] == pytest.approx(-last["reactions"]["block_top"][1], rel=1e-8)

@@ -209,3 +209,63 @@ def test_overlapping_physical_groups_are_refused_before_meshing(tmp_path):
                                          r"physical groups, 'bridge_top' and 'bridge_ends'.*"
                                          r"Make the groups disjoint"):
         build_mesh(load_scene(scene_file))
+
+
+OPEN_LOOP_GEO = """Geometry.AutoCoherence = 0;
+Point(1) = {0, 0, 0, 0.1}; Point(2) = {1, 0, 0, 0.1}; Point(3) = {1, 1, 0, 0.1};
+Point(4) = {0, 1, 0, 0.1}; Point(5) = {0, 0, 0, 0.1};  // a second point where the first is
+Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 5};
+Curve Loop(1) = {1, 2, 3, 4}; Plane Surface(1) = {1};
+Physical Surface("block", 1) = {1}; Physical Curve("bottom", 1) = {1};
+Physical Curve("top", 2) = {3};
+"""
+
+
+def test_a_geometry_gmsh_cannot_mesh_is_named_without_a_traceback(tmp_path, capsys):
+    """A loop that does not close (two points at one place) reads, but does not mesh."""
+    from fenics_contact.cli import main
+
+    (tmp_path / "open.geo").write_text(OPEN_LOOP_GEO)
+    (tmp_path / "open.toml").write_text(
+        '[scene]\nname = "open"\ndimension = 2\n[mesh]\nfile = "open.geo"\n[material]\n'
+        'law = "linear"\nE = 100.0\nnu = 0.3\n[[dirichlet]]\ntag = "top"\n'
+        'value = [0.0, -0.01]\n[obstacle]\ntype = "plane"\npoint = [0.0, 0.0]\n'
+        'normal = [0.0, 1.0]\n[contact]\ntag = "bottom"\n')
+    assert main(["run", str(tmp_path / "open.toml"), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert re.search(r"open.toml: \[mesh\] file = '.*open.geo': gmsh could not mesh it \(The "
+                     r"1D mesh seems not to be forming a closed loop", err), err
+
+
+def test_a_msh_file_whose_nodes_are_numbered_with_gaps_runs(tmp_path):
+    """gmsh numbers a file's nodes as it pleases (1 ... N with gaps after edits): renumbered."""
+    import gmsh
+
+    from fenics_contact import run_scene
+    from fenics_contact.scene.schema import load_scene
+
+    shipped = Path(__file__).parents[1] / "scenes" / "block_on_block.toml"
+    geo = shipped.parents[1] / "meshes" / "block_on_block.geo"
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.open(str(geo))
+        gmsh.model.mesh.generate(2)
+        tags, _, _ = gmsh.model.mesh.getNodes()
+        gmsh.model.mesh.renumberNodes(tags, 3 * tags + 7)  # gaps
+        gmsh.option.setNumber("Mesh.SaveAll", 0)
+        gmsh.write(str(tmp_path / "gaps.msh"))
+    finally:
+        gmsh.finalize()
+    text = shipped.read_text().replace('file = "../meshes/block_on_block.geo"',
+                                       f'file = "{tmp_path}/gaps.msh"')
+    text = "\n".join(line for line in text.splitlines() if not line.startswith("parameters"))
+    (tmp_path / "gaps.toml").write_text(text)
+    outcome = run_scene(load_scene(tmp_path / "gaps.toml"), tmp_path / "run", pictures=False)
+    assert outcome.path.converged
+    assert outcome.problem.contact_state().contact_force == pytest.approx(
+        -PATCH_PRESSURE, rel=1e-9)
+
+
+PATCH_PRESSURE = -200.0 / (1 - 0.3**2) * 0.01

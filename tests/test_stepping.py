@@ -65,3 +65,16 @@ def test_a_nan_residual_is_not_read_as_one_that_met_its_tolerance():
     assert refusal(strategy, nan) is None
     above = SolveResult(Status.DIVERGED, 2, 0, 2, [34.1, 20.5])
     assert refusal(strategy, above) is None
+
+
+def test_a_step_whose_residual_is_nan_from_the_start_says_so():
+    """Every attempt's first residual NaN: the message says no Newton step could be taken."""
+    from fenics_contact.solvers.stepping import StepRecord, _failure_message
+
+    record = StepRecord(step=1, load_factor=0.0, status=Status.DIVERGED, cutbacks=1,
+                        residuals=[[float("nan")], [float("nan")]])
+    message = _failure_message(record, 0.125)
+    assert message.startswith("diverged at load factor 0.125 after 2 attempts")
+    assert "NaN or infinite at its first evaluation in every attempt" in message
+    record.residuals = [[float("nan")], [3.0, float("nan")]]  # one attempt got going
+    assert "NaN" not in _failure_message(record, 0.125)

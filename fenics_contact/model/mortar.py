@@ -42,6 +42,7 @@ from fenics_contact.model.friction import FrictionSettings
 from fenics_contact.model.search import penetration_depth
 from fenics_contact.model.segments import (
     NEAR,
+    OPPOSING,
     REACH,
     SLOTS,
     Polyline,
@@ -246,11 +247,15 @@ class MortarTransfer:
                 hi = ufl.min_value(ufl.max_value(xa, xb), 1.0)
                 span = ufl.max_value(hi - lo, 0.0)
                 n_t = _perp(b - a)
-                denom = m_k * ufl.dot(n_s, n_t) - (1.0 - m_k)
+                # a slot serves both facets of the node; the one it does not face (a
+                # striker turning a corner) gets nothing from it, as in the search
+                facing = ufl.conditional(
+                    ufl.lt(ufl.dot(n_s, n_t), -OPPOSING * ufl.sqrt(ufl.dot(n_t, n_t))), 1.0, 0.0)
+                denom = m_k * facing * ufl.dot(n_s, n_t) - (1.0 - m_k * facing)
                 for q, wq in _GAUSS:
                     xi = lo + span * q
                     alpha = ufl.dot(a - (x1 + xi * t), n_t) / denom
-                    weight = m_f * m_k * length * span * wq * shape(xi)
+                    weight = m_f * m_k * facing * length * span * wq * shape(xi)
                     points.append((weight, (x1, x2, s, n_s), (k, a, b), xi, alpha))
         return points, full
 

@@ -187,7 +187,12 @@ def _from_gmsh(scene: Scene, comm: MPI.Comm) -> BodyMesh:
         if spec.file is not None and spec.file.suffix == ".geo":
             gmsh.model.mesh.generate(scene.dimension)
 
-    data = mesh_on_rank(comm, 0, scene.dimension, build)
+    try:
+        data = mesh_on_rank(comm, 0, scene.dimension, build)
+    except ValueError as exc:
+        raise SceneError(f"{scene.path.name}: [mesh] file = {str(spec.file)!r}: gmsh could not "
+                         f"mesh it ({exc}); check the geometry (closed curve loops, surfaces "
+                         "that do not cross) and the mesh sizes.") from exc
     if data.facet_tags is None:
         raise SceneError(f"{spec.file}: the mesh has no physical groups on its boundary.")
     fdim = scene.dimension - 1

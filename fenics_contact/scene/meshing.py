@@ -57,15 +57,30 @@ def mesh_on_rank(
 
     Uses the caller's gmsh session when one is open (its model is removed
     afterwards), or opens and closes its own. ``build`` must add and mesh a
-    model with physical groups.
+    model with physical groups. Its nodes and elements are numbered 1 ... N
+    before the mesh is handed over (a .msh file may number them with gaps).
+    When ``build`` fails (gmsh cannot mesh the geometry), every rank raises
+    ``ValueError`` with gmsh's reason.
     """
     if comm.rank != rank:
         import gmsh
 
+        problem = comm.bcast(None, root=rank)
+        if problem:
+            raise ValueError(problem)
         return model_to_mesh(gmsh.model, comm, rank, gdim=gdim)
     with gmsh_session() as (gmsh, opened):
         try:
-            build(gmsh)
+            problem = ""
+            try:
+                build(gmsh)
+                gmsh.model.mesh.renumberNodes()
+                gmsh.model.mesh.renumberElements()
+            except Exception as exc:  # gmsh raises bare Exception
+                problem = " ".join(str(exc).split()) or type(exc).__name__
+            comm.bcast(problem, root=rank)
+            if problem:
+                raise ValueError(problem)
             return model_to_mesh(gmsh.model, comm, rank, gdim=gdim)
         finally:
             if not opened:

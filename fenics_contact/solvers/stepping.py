@@ -274,6 +274,11 @@ def _failure_message(record: StepRecord, t_try: float, refused: str | None = Non
             "reduce the load, its initial penetration or r, or refine the mesh there"
         )
     message = f"{record.status} at load factor {t_try:.4g} after {_attempts(record)}"
+    firsts = [r[0] for r in record.residuals if r]
+    if firsts and not any(math.isfinite(r) for r in firsts):
+        message += ("; the residual was NaN or infinite at its first evaluation in every attempt "
+                    "(no Newton step could be taken): a form gave a non-number at the step's "
+                    "start state")
     if refused:
         message += f"; the residual met its tolerance but the iterate was refused: {refused}"
     return message
