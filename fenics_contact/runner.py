@@ -280,6 +280,7 @@ def run_scene(
 
     def finished(step: StepRecord) -> None:
         step.reactions = problem.support_reactions()
+        step.reaction_total = problem.support_total()
         writer.write(step.load_factor)
         history = strategy.history if isinstance(strategy, Extrapolated) else []
         gaps = strategy.gap_history if isinstance(strategy, ActiveSetPredicted) else []
@@ -307,6 +308,7 @@ def run_scene(
     if path.steps and path.steps[-1].status != "converged":
         # the failed step's record holds the state the run stopped in (restored)
         path.steps[-1].reactions = problem.support_reactions()
+        path.steps[-1].reaction_total = problem.support_total()
     summary = _write_summary(comm, out, scene, path, used)
     warn_untagged_penetration(scene, problem)
     warn_body_overlap(scene, problem)

@@ -329,3 +329,23 @@ def test_screen_axes_do_not_turn_with_round_off():
     np.testing.assert_allclose(up_a, up_b, atol=1e-12)
     np.testing.assert_allclose(right_a, right_b, atol=1e-12)
     assert abs(up_a[1]) > 0.999  # y, the first of the global axes least along n (z excluded)
+
+
+def test_the_friction_profile_draws_the_traction_on_the_body_along_the_axis(tmp_path):
+    """A plane moving +x drags the block's face +x: the drawn traction is positive where
+    the nodes slip. The same vector for a pair: its own tangent frame (which turned the
+    sign of pairs before) no longer enters."""
+    from fenics_contact import load_scene, run_scene
+    from fenics_contact.output.friction_plot import friction_profile_data
+
+    scenes = Path(__file__).parents[1] / "scenes"
+    outcome = run_scene(load_scene(scenes / "block_slide_friction.toml"), tmp_path / "slide",
+                        pictures=False)
+    data = friction_profile_data(outcome.problem)
+    if data is None:  # not process 0
+        return
+    (profile,) = data.values()
+    slipping = profile["state"] == 2
+    assert slipping.sum() > 5
+    assert np.all(profile["traction"][slipping] > 0.0)
+    assert np.allclose(profile["traction"][slipping], profile["limit"][slipping], rtol=1e-6)

@@ -403,6 +403,28 @@ class Solid:
         Over supports that share no prescribed component, the reactions
         balance the contact forces and the tractions. Collective.
         """
+        vec, held = self._support_dofs()
+        local = np.array([[vec[np.unique(np.concatenate(c))].sum() if c else 0.0
+                           for c in parts] for parts in held.values()]).reshape(-1, self.gdim)
+        total = self.comm.allreduce(local, op=MPI.SUM)
+        return {name: [float(v) for v in row] for name, row in zip(held, total, strict=True)}
+
+    def support_total(self) -> list[float]:
+        """The force all supports together exert on the bodies, per component (collective).
+
+        Each prescribed component of a node counts once, where
+        :meth:`support_reactions` counts a component two supports share in
+        both: this total balances the contact forces and the tractions.
+        """
+        vec, held = self._support_dofs()
+        local = np.array([
+            vec[np.unique(np.concatenate([d for parts in held.values() for d in parts[i]]
+                                         or [np.zeros(0, np.int32)]))].sum()
+            for i in range(self.gdim)])
+        return [float(v) for v in self.comm.allreduce(local, op=MPI.SUM)]
+
+    def _support_dofs(self) -> tuple[np.ndarray, dict[str, list[list[np.ndarray]]]]:
+        """(nodal forces, owned dofs per support and component) for the reactions."""
         vec = self._internal_force()
         recorded = getattr(self, "_support_residual", None)
         if recorded is not None and np.array_equal(recorded[2], self.u.x.array):
@@ -418,10 +440,7 @@ class Solid:
                 if value is not None:
                     dofs = fem.locate_dofs_topological(self.V.sub(i), fdim, condition.facets)
                     parts[i].append(dofs[dofs < n_owned])
-        local = np.array([[vec.array[np.unique(np.concatenate(c))].sum() if c else 0.0
-                           for c in parts] for parts in held.values()]).reshape(-1, self.gdim)
-        total = self.comm.allreduce(local, op=MPI.SUM)
-        return {name: [float(v) for v in row] for name, row in zip(held, total, strict=True)}
+        return vec.array, held
 
     def stresses(self) -> list[tuple[ufl.core.expr.Expr, np.ndarray | None]]:
         """Each body's Cauchy stress (3 x 3, UFL, with the moduli constants) and its cells."""

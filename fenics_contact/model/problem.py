@@ -396,6 +396,10 @@ class ContactProblem(FrictionalContacts):
         """Each support's force on the bodies (see :meth:`Solid.support_reactions`)."""
         return self.solid.support_reactions()
 
+    def support_total(self) -> list[float]:
+        """All supports' force on the bodies, each held component once (see Solid)."""
+        return self.solid.support_total()
+
     def prescribed_mismatch(self) -> float:
         """Largest |u - u_D| over the prescribed components (length, global)."""
         return self.solid.prescribed_mismatch()

@@ -4,8 +4,8 @@ Matplotlib (Agg backend, no display). Collective: every process gives its
 owned contact nodes, process 0 draws one panel per frictional contact. The
 abscissa is the reference coordinate along which the contact surface
 extends most (x for a horizontal plane, y for a vertical wall). The traction
-drawn is the tangential traction the partner puts on the body (its first
-tangential component in 2D, its magnitude in 3D) with the limits +-mu p;
+drawn is the tangential traction the partner puts on the body (in 2D its
+component along the abscissa's axis, in 3D its magnitude) with the limits +-mu p;
 sticking nodes are drawn as filled dots, slipping nodes as crosses. A
 contact zone spanning under half the surface is shown alone.
 """
@@ -31,7 +31,7 @@ def friction_profile_data(problem: ContactProblem) -> dict[str, dict[str, np.nda
     """Gathered nodal data of each frictional contact on process 0 (None elsewhere).
 
     By contact name, sorted along the abscissa. Keys: s (abscissa, length),
-    axis (its name), traction (stress: -tau in 2D, |tau| in 3D), limit (mu p
+    axis (its name), traction (stress: along the axis in 2D, |tau| in 3D), limit (mu p
     >= 0, stress), state (0 open, 1 stick, 2 slip).
     """
     comm = problem.comm
@@ -46,8 +46,10 @@ def friction_profile_data(problem: ContactProblem) -> dict[str, dict[str, np.nda
         lo = np.min([r[0] for r in ranges], axis=0)
         hi = np.max([r[1] for r in ranges], axis=0)
         axis = int(np.argmax(hi - lo))
-        tau = state.tangential_traction  # type: ignore[attr-defined]
-        traction = -tau[:, 0] if problem.gdim == 2 else np.linalg.norm(tau, axis=1)
+        # the traction on the body as a vector: the same sign for obstacles and pairs,
+        # whatever way each contact's tangent frame turns
+        vector, _ = contact.friction.tangential_fields()
+        traction = vector[:, axis] if problem.gdim == 2 else np.linalg.norm(vector, axis=1)
         local = np.column_stack([coords[:, axis], traction, state.coulomb_limit,  # type: ignore
                                  state.node_state])  # type: ignore[attr-defined]
         parts = comm.gather(local, root=0)

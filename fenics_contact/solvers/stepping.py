@@ -70,6 +70,10 @@ class StepRecord:
             scene tag) exerts on the bodies at the end of the step, per
             component (force, per thickness in 2D); filled by the scene
             runner for every finished step, empty for a failed one.
+        reaction_total: the force all supports together exert, each held
+            component of a node counted once (``reactions`` counts a component
+            two supports share, as a fixed base meeting a symmetry plane, in
+            both); it balances the contact forces and the tractions.
     """
 
     step: int
@@ -92,6 +96,7 @@ class StepRecord:
     slip_count: int = 0
     contacts: dict[str, dict] = field(default_factory=dict)
     reactions: dict[str, list[float]] = field(default_factory=dict)
+    reaction_total: list[float] = field(default_factory=list)
 
     def to_dict(self) -> dict:
         """Plain-data view for JSON."""
