@@ -593,7 +593,8 @@ def _overlapping(tmp_path, depth: float) -> Path:
 @pytest.mark.mpi
 def test_bodies_starting_deep_inside_each_other_are_refused(tmp_path):
     # h = 1/8 on the striker face: 0.2 is 1.6 h
-    with pytest.raises(SceneError, match=r"the bodies start 0.2 inside each other near "
+    with pytest.raises(SceneError, match=r"\[\[pair\]\] '[^']+': the bodies '[^']+' and "
+                       r"'[^']+' start 0.2 inside each other near "
                        r"\([0-9.]+, 0.3\), more than the striker facet size h = 0.125"):
         _build(_overlapping(tmp_path, 0.2))
 
@@ -604,7 +605,8 @@ def test_mortar_bodies_starting_deep_inside_each_other_are_refused(tmp_path):
     text = path.read_text().replace('target = "target_face"',
                                     'target = "target_face"\ndiscretisation = "mortar"')
     path.write_text(text)
-    with pytest.raises(SceneError, match=r"the bodies start 0.2 inside each other near "
+    with pytest.raises(SceneError, match=r"\[\[pair\]\] '[^']+': the bodies '[^']+' and "
+                       r"'[^']+' start 0.2 inside each other near "
                        r"\([0-9.]+, 0.3\), more than the striker facet size h = 0.125"):
         _build(path)
 
@@ -612,7 +614,8 @@ def test_mortar_bodies_starting_deep_inside_each_other_are_refused(tmp_path):
 def test_shallow_initial_overlap_is_reported_and_runs(tmp_path):
     from fenics_contact.scene.checks import SceneWarning
 
-    with pytest.warns(SceneWarning, match=r"the bodies start 0.01 \(0.08 h\) inside each other"):
+    with pytest.warns(SceneWarning, match=r"the bodies '[^']+' and '[^']+' start 0.01 "
+                                            r"\(0.08 h\) inside each other"):
         _build(_overlapping(tmp_path, 0.01))
 
 
@@ -643,3 +646,16 @@ def test_boundary_nodes_outside_the_tag_inside_an_obstacle_are_warned_about(tmp_
     with warnings.catch_warnings():
         warnings.simplefilter("error", SceneWarning)
         assert warn_untagged_penetration(load_scene(tmp_path / "scene.toml"), problem) == 0
+
+
+def test_a_pair_tag_mistake_names_the_pair(tmp_path):
+    """Of two pairs, the one whose striker tag is wrong is named."""
+    from fenics_contact.scene.build import build_problem
+
+    shipped = Path(__file__).parents[1] / "scenes" / "bridge.toml"
+    text = shipped.read_text().replace('"../meshes/', f'"{shipped.parents[1]}/meshes/')
+    (tmp_path / "bridge.toml").write_text(
+        text.replace('striker = "bridge_under_right"', 'striker = "bridge_under_rihgt"'))
+    with pytest.raises(SceneError, match=r"\[\[pair\]\] 'on-right' striker tag = "
+                                         r"'bridge_under_rihgt' is not a facet tag"):
+        build_problem(load_scene(tmp_path / "bridge.toml"))

@@ -53,6 +53,7 @@ def _names(gdim: int) -> list[str]:
 def free_rigid_motions(
     domain: mesh.Mesh,
     conditions: Sequence[tuple[np.ndarray, Sequence[float | None]]],
+    cells: np.ndarray | None = None,
 ) -> list[str]:
     """Names of the rigid motions that the prescribed components leave free.
 
@@ -60,6 +61,8 @@ def free_rigid_motions(
         domain: the body mesh.
         conditions: (local facet indices, value per component with None for a
             free component) of each Dirichlet condition.
+        cells: the body's cells in a mesh of several bodies (None: every cell);
+            a rotation is named about the centre of their bounding box.
 
     Returns:
         An empty list when every rigid motion is held, else one phrase per
@@ -70,10 +73,11 @@ def free_rigid_motions(
     tdim = domain.topology.dim
     comm = domain.comm
     x = domain.geometry.x[:, :gdim]
+    own = x if cells is None else x[np.unique(domain.geometry.dofmaps[0][cells])]
     lo = np.empty(gdim)
     hi = np.empty(gdim)
-    comm.Allreduce(x.min(axis=0) if x.size else np.full(gdim, np.inf), lo, op=MPI.MIN)
-    comm.Allreduce(x.max(axis=0) if x.size else np.full(gdim, -np.inf), hi, op=MPI.MAX)
+    comm.Allreduce(own.min(axis=0) if own.size else np.full(gdim, np.inf), lo, op=MPI.MIN)
+    comm.Allreduce(own.max(axis=0) if own.size else np.full(gdim, -np.inf), hi, op=MPI.MAX)
     centre = 0.5 * (lo + hi)
     size = float(np.max(hi - lo)) or 1.0
     n_modes = 3 if gdim == 2 else 6

@@ -218,8 +218,9 @@ def tagged_facets(body: BodyMesh, scene: Scene, section: str, tag: int | str) ->
     available = sorted(set(comm.allreduce(body.facet_tags.values.tolist(), op=MPI.SUM)))
     named = ", ".join(f"{n} = {t}" for n, t in sorted(body.names.items(), key=lambda kv: kv[1]))
     if number is None or number not in available:
+        label = section if section.startswith("[") else f"[{section}]"
         raise SceneError(
-            f"{scene.path.name}: [{section}] tag = {tag!r} is not a facet tag of the mesh; "
+            f"{scene.path.name}: {label} tag = {tag!r} is not a facet tag of the mesh; "
             f"available: {named or ', '.join(map(str, available))}."
         )
     return body.facet_tags.find(number)
@@ -353,8 +354,8 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
     prescribed, tractions = boundary_conditions(scene, body)
     contacts: list = []
     for pair in scene.pairs:
-        striker = tagged_facets(body, scene, "pair striker", pair.striker)
-        target = tagged_facets(body, scene, "pair target", pair.target)
+        striker = tagged_facets(body, scene, f"[[pair]] {pair.name!r} striker", pair.striker)
+        target = tagged_facets(body, scene, f"[[pair]] {pair.name!r} target", pair.target)
         check_pair_surfaces(scene, body.domain, body.cell_tags, bodies, striker, target, pair)
         friction = (None if pair.mu is None
                     else FrictionSettings(pair.mu, pair.tangential_r_max))

@@ -333,7 +333,8 @@ def check_bodies_held(
     for body in bodies:
         marker = _body_cells(domain, cell_tags, body.tag)
         own = [(_facets_on(domain, marker, p.facets), p.at(1.0)) for p in prescribed]
-        motions = free_rigid_motions(domain, own)
+        motions = free_rigid_motions(
+            domain, own, None if body.tag is None else cell_tags.find(body.tag))
         if motions:
             free.append((body.name, motions))
     if not free:
@@ -423,16 +424,20 @@ def _refuse_deep_overlap(scene: Scene, contact, depth: np.ndarray, warn_from: fl
         return 0.0
     deepest, where = -found[0], _where(found[1], contact.gdim)
     h = contact.surface.h
+    bodies = [getattr(getattr(contact, f"{role}_body", None), "name", None)
+              for role in ("striker", "target")]
+    who = (f"[[pair]] {contact.name!r}: the bodies {bodies[0]!r} and {bodies[1]!r}"
+           if None not in bodies else f"[[pair]] {contact.name!r}: the bodies")
     if deepest > h:
         raise SceneError(
-            f"{scene.path.name}: the bodies start {deepest:.4g} inside each other near {where}, "
+            f"{scene.path.name}: {who} start {deepest:.4g} inside each other near {where}, "
             f"more than the striker facet size h = {h:.4g}; move one body out of the other in "
             "the mesh and let [[dirichlet]] values bring them into contact."
         )
     if deepest > warn_from * h:
         warnings.warn(
             SceneWarning(
-                f"{scene.path.name}: the bodies start {deepest:.3g} ({deepest / h:.2g} h) inside "
+                f"{scene.path.name}: {who} start {deepest:.3g} ({deepest / h:.2g} h) inside "
                 f"each other near {where}; the first load step pushes them apart."
             ),
             stacklevel=2,
