@@ -58,3 +58,19 @@ def test_blocks_whose_faces_meet_whole_overlap_by_round_off_only(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error", SceneWarning)
         assert warn_body_overlap(scene, outcome.problem) < 1e-12
+
+
+def test_an_automatic_contact_is_named_as_such_with_a_fix_that_applies(tmp_path):
+    """Automatic pairing of the bridge: the support's corner again; the advice is to declare
+    the pair (the automatic contact's striker and target are not the user's to retag)."""
+    text = (ROOT / "scenes" / "bridge.toml").read_text().replace(
+        '"../meshes/', f'"{ROOT}/meshes/')
+    text = text[:text.index("[[pair]]")] + "[pairing]\nautomatic = true\n\n" + \
+        text[text.index("[[dirichlet]]"):]
+    (tmp_path / "auto.toml").write_text(text)
+    with pytest.warns(SceneWarning) as seen:
+        run_scene(load_scene(tmp_path / "auto.toml"), tmp_path / "run", pictures=False)
+    named = [str(w.message) for w in seen if "inside body" in str(w.message)]
+    assert len(named) == 2
+    assert all("[pairing] automatic contact '" in m and "declare these two bodies as a [[pair]]"
+               in m for m in named)

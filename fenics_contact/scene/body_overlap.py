@@ -113,7 +113,14 @@ def warn_body_overlap(scene: Scene, problem: ContactProblem) -> float:
                 "the striker surface" if striker is target else
                 f"a boundary node of body {inner.name!r} lies {depth:.3g} ({depth / h:.1%} of h) "
                 f"inside body {outer.name!r}")
-        if mortar:
+        declared = contact.name in {p.name for p in scene.pairs}
+        label = f"[[pair]] {contact.name!r}" if declared else \
+            f"[pairing] automatic contact {contact.name!r}"
+        if not declared:
+            fix = ("The pair holds its striker nodes out of the target only: declare these two "
+                   "bodies as a [[pair]] (its striker and target of your choosing, or "
+                   'discretisation = "mortar"), which [pairing] then leaves to it.')
+        elif mortar:
             fix = ("A mortar pair holds weighted gaps, not single nodes: refine both surfaces "
                    "where they touch, or tag the striker wherever the partner may reach.")
         elif striker is target:
@@ -126,7 +133,7 @@ def warn_body_overlap(scene: Scene, problem: ContactProblem) -> float:
                    "wherever the partner may reach, let the finer surface strike, or use "
                    'discretisation = "mortar".')
         warnings.warn(SceneWarning(
-            f"{scene.path.name}: [[pair]] {contact.name!r}: {what}, near ({where}). {fix}"),
+            f"{scene.path.name}: {label}: {what}, near ({where}). {fix}"),
             stacklevel=2)
     return deepest
 
