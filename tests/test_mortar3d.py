@@ -63,6 +63,17 @@ def test_mortar3d_patch_non_matching(h_upper: float, h_lower: float) -> None:
     problem, body = _patch(h_upper, h_lower)
     its = _solve(problem, "gnrm", 2)
     assert its[0] <= 5 and its[1] <= 2, its
+    state = _assert_uniform_patch(problem, body)
+    assert state.max_penetration <= 1e-12
+    f = problem.target_force()
+    n = problem.V.dofmap.index_map.size_local
+    total = problem.comm.allreduce(f.x.array[: 3 * n].reshape(-1, 3).sum(axis=0), op=MPI.SUM)
+    assert abs(total[2] + state.contact_force) <= 1e-10 * state.contact_force
+    assert np.all(np.abs(total[:2]) <= 1e-10 * state.contact_force)
+
+
+def _assert_uniform_patch(problem, body):
+    """Uniform pressure, the contact force, and top and bottom reactions that balance it."""
     state = problem.contact_state()
     np.testing.assert_allclose(state.pressure, PATCH_PRESSURE, rtol=1e-8)
     assert state.contact_force == pytest.approx(-PATCH_PRESSURE * 0.25, rel=1e-10)
@@ -70,12 +81,7 @@ def test_mortar3d_patch_non_matching(h_upper: float, h_lower: float) -> None:
     bottom = problem.reaction(body.facet_tags.find(body.names["bottom"]))[2]
     assert abs(top + bottom) <= 1e-10 * state.contact_force
     assert abs(-top - state.contact_force) <= 1e-10 * state.contact_force
-    assert state.max_penetration <= 1e-12
-    f = problem.target_force()
-    n = problem.V.dofmap.index_map.size_local
-    total = problem.comm.allreduce(f.x.array[: 3 * n].reshape(-1, 3).sum(axis=0), op=MPI.SUM)
-    assert abs(total[2] + state.contact_force) <= 1e-10 * state.contact_force
-    assert np.all(np.abs(total[:2]) <= 1e-10 * state.contact_force)
+    return state
 
 
 def _mirrored_patch():
@@ -99,13 +105,7 @@ def test_mortar3d_patch_on_mirrored_meshes() -> None:
     problem, body = _mirrored_patch()
     its = _solve(problem, "gnrm", 2, max_iterations=30)
     assert its[0] <= 5 and its[1] <= 2, its
-    state = problem.contact_state()
-    np.testing.assert_allclose(state.pressure, PATCH_PRESSURE, rtol=1e-8)
-    assert state.contact_force == pytest.approx(-PATCH_PRESSURE * 0.25, rel=1e-10)
-    top = problem.reaction(body.facet_tags.find(body.names["top"]))[2]
-    bottom = problem.reaction(body.facet_tags.find(body.names["bottom"]))[2]
-    assert abs(top + bottom) <= 1e-10 * state.contact_force
-    assert abs(-top - state.contact_force) <= 1e-10 * state.contact_force
+    _assert_uniform_patch(problem, body)
 
 
 @pytest.mark.parametrize("mu", [None, 0.3])

@@ -22,17 +22,17 @@ import warnings
 from typing import TYPE_CHECKING
 
 import numpy as np
-from dolfinx import fem, mesh
+from dolfinx import fem
 
 from mpi4py import MPI
 
+from fenics_contact.model.automatic_pairing import body_surfaces
 from fenics_contact.model.mortar import MortarContact
 from fenics_contact.model.search import penetration_depth
 from fenics_contact.model.segments import Polyline
 from fenics_contact.model.target_surface import free_sides
 
 if TYPE_CHECKING:
-    from fenics_contact.model.body import Body
     from fenics_contact.model.problem import ContactProblem
     from fenics_contact.scene.schema import Scene
 
@@ -40,23 +40,6 @@ if TYPE_CHECKING:
 WARN_DEPTH = 1e-2
 #: The same for a mortar pair, whose weighted gaps let single nodes in a little.
 WARN_DEPTH_MORTAR = 5e-2
-
-
-def _boundary_facets(problem: ContactProblem, body: Body) -> np.ndarray:
-    """Owned exterior facets of ``body``'s cells (local indices)."""
-    domain = problem.domain
-    tdim = domain.topology.dim
-    domain.topology.create_connectivity(tdim - 1, tdim)
-    facets = mesh.exterior_facet_indices(domain.topology)
-    tags = problem.solid.cell_tags
-    if body.tag is None or tags is None:
-        return facets
-    cell_tag = np.full(domain.topology.index_map(tdim).size_local
-                       + domain.topology.index_map(tdim).num_ghosts, -1, np.int64)
-    cell_tag[tags.indices] = tags.values
-    f2c = domain.topology.connectivity(tdim - 1, tdim)
-    cells = np.array([f2c.links(f)[0] for f in facets], np.int64)
-    return facets[cell_tag[cells] == body.tag] if facets.size else facets
 
 
 def _inside(problem: ContactProblem, facets: np.ndarray,
@@ -96,7 +79,9 @@ def warn_body_overlap(scene: Scene, problem: ContactProblem) -> float:
                 continue  # one surface: every node is a striker node
             found = [_inside(problem, contact.target_facets, contact.facets), (0.0, None)]
         else:
-            sides = [_boundary_facets(problem, b) for b in (target, striker)]
+            surfaces = body_surfaces(problem.domain, problem.solid.cell_tags,
+                                     [target, striker])
+            sides = [surfaces[b.name] for b in (target, striker)]
             found = [_inside(problem, sides[0], sides[1]), _inside(problem, sides[1], sides[0])]
         depths = [comm.allreduce(d, op=MPI.MAX) for d, _ in found]
         which = int(np.argmax(depths))
