@@ -5,6 +5,11 @@ to it is a symmetry plane; at the contact nodes on it the traction across
 the plane is zero by symmetry, and the model constrains it (before, a
 sticking node there left that multiplier component undetermined: a singular
 Jacobian and PETSc's "error code 73").
+
+Against a rigid obstacle any held component along a tangent is data: where
+the obstacle moves along it, the held node slides and its friction goes into
+the support's reaction (before, the step was refused: "slip at sticking
+nodes").
 """
 
 from pathlib import Path
@@ -128,6 +133,7 @@ def test_a_failed_linear_solve_is_a_status_not_a_petsc_error(tmp_path, monkeypat
     import fenics_contact.model.friction_terms as friction_terms
 
     monkeypatch.setattr(friction_terms, "symmetry_planes", lambda domain, conditions: [])
+    monkeypatch.setattr(friction_terms, "held_components", lambda conditions: [])
     path = tmp_path / "half.toml"
     path.write_text(HEAD.format(name="half", origin="[0.0, 0.0, 0.0]", size="[1.0, 0.5, 0.5]",
                                 cells="[4, 2, 2]", steps=4)
@@ -198,3 +204,66 @@ def test_quarter_model_of_two_frictional_hemispheres(tmp_path):
     # a stiffer striker expands less sideways: the interface slips, the model still converges
     stiff = _hemispheres(tmp_path, "stiff", 0.3, striker_E=1000.0).path.steps[-1]
     assert stiff.slip_count > 0 and stiff.tangential_force > 0.0
+
+
+SCENES = Path(__file__).parents[1] / "scenes"
+
+
+def test_a_held_side_on_a_sliding_plane_slides_at_the_coulomb_limit(tmp_path):
+    """``block_slide_friction.toml`` with its left side held in x: the plane drags the
+    bottom-left corner, held in x, along; at gross sliding the friction is mu N, all of
+    it in the supports' reactions."""
+    text = (SCENES / "block_slide_friction.toml").read_text()
+    path = tmp_path / "held.toml"
+    path.write_text(text.replace("[obstacle]", '[[dirichlet]]\ntag = "left"\n'
+                                 'value = [0.0, "free"]\n\n[obstacle]'))
+    scene = load_scene(path)
+    outcome = run_scene(scene, tmp_path / "out", comm=MPI.COMM_SELF, pictures=False)
+    steps = outcome.path.steps
+    assert outcome.path.status == "converged", steps[-1].message
+    assert len(steps) == scene.solver.steps
+    problem = outcome.problem
+    assert problem.symmetry_constraints == 1  # the corner: left side and plane
+    for step in steps:
+        if step.load_factor <= 0.4:  # pressed, not dragged: nothing slides, no friction
+            assert step.tangential_force <= 1e-10 * step.contact_force
+            assert step.slip_count == 0
+    last = steps[-1]
+    assert last.slip_count == last.active_count == 21
+    assert last.tangential_force == pytest.approx(0.3 * last.contact_force, rel=1e-8)
+    # the held corner's friction is in the reactions: they balance the contact force
+    np.testing.assert_allclose(problem.support_total(),
+                               [-last.tangential_force, -last.contact_force],
+                               rtol=1e-8)
+    state = problem.contact_state()
+    corner = np.argmin(np.linalg.norm(problem.nodal_coordinates(), axis=1))
+    assert state.node_state[corner] == 2  # slips
+    assert abs(state.tangential_traction[corner, 0]) == pytest.approx(
+        0.3 * abs(state.pressure[corner]), rel=1e-8)
+
+
+def test_a_held_face_on_a_sliding_plane_in_3d_with_a_symmetry_cut(tmp_path):
+    """3D, half model cut at y = 0: the face x = 0 is held in x while the plane presses
+    and then slides along x; the edge on both planes slides along x and is symmetric
+    across y."""
+    body = ('[[dirichlet]]\ntag = "zmax"\nvalue = [0.0, 0.0, 0.0]\n'
+            '[[dirichlet]]\ntag = "xmin"\nvalue = [0.0, "free", "free"]\n'
+            + SYM_Y +
+            '[obstacle]\ntype = "plane"\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\n'
+            'schedule = [[0.0, 0.0, 0.0, 0.0], [0.5, 0.0, 0.0, 0.01], '
+            '[1.0, 0.03, 0.0, 0.01]]\n')
+    problem, _state, path = _run(tmp_path, "held3d", body, origin="[0.0, 0.0, 0.0]",
+                                size="[1.0, 0.5, 0.5]", cells="[4, 2, 2]", steps=4)
+    # x = 0 holds 3 contact nodes along x; y = 0 holds 5 across y (one node on both)
+    assert problem.symmetry_constraints == 8
+    last = path.steps[-1]
+    assert last.slip_count == last.active_count
+    # every node slides at the limit; the slip turns a little off x where the pressed
+    # block spreads in y, so the resultant is a little below mu N
+    assert 0.995 * 0.3 * last.contact_force < last.tangential_force
+    assert last.tangential_force <= 0.3 * last.contact_force * (1 + 1e-12)
+    # the held face's friction is in the reactions: they balance the contact's forces
+    total = problem.support_total()
+    assert np.hypot(total[0], total[1]) == pytest.approx(last.tangential_force, rel=1e-8)
+    assert total[0] < -0.99 * last.tangential_force
+    assert total[2] == pytest.approx(-last.contact_force, rel=1e-8)

@@ -49,6 +49,9 @@ class Contact:
     multiplier_is_pressure = True
     #: Options of the just-in-time compilation of this contact's forms (None: defaults).
     jit_options: dict | None = None
+    #: Whether a held displacement along a tangent makes the slip there data (a rigid
+    #: partner): friction then treats held nodes (:class:`~.friction_terms.CoulombFriction`).
+    held_slip_is_data = False
 
     def __init__(
         self,

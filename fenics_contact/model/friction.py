@@ -128,6 +128,19 @@ def symmetry_planes(
     return planes
 
 
+def held_components(conditions: Sequence[object]) -> list[tuple[np.ndarray, int]]:
+    """(facets, axis) of every displacement component a Dirichlet condition holds."""
+    out = []
+    for condition in conditions:
+        value = condition.value  # type: ignore[attr-defined]
+        path = getattr(condition, "path", ())
+        axes = range(len(path[0]) - 1) if path else [i for i, v in enumerate(value)
+                                                      if v is not None]
+        facets = np.asarray(condition.facets, dtype=np.int32)  # type: ignore[attr-defined]
+        out += [(facets, int(a)) for a in axes]
+    return out
+
+
 def plane_axes(V: fem.FunctionSpace, planes: list[tuple[np.ndarray, int]],
                ) -> tuple[fem.Function, fem.Function] | None:
     """Nodal data of the symmetry planes for a pair's tangent frame (None without planes).

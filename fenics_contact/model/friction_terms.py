@@ -26,11 +26,16 @@ from fenics_contact.model.friction import (
     FrictionalContactState,
     FrictionSettings,
     coulomb_projection,
+    held_components,
     sticks,
     surface_extent,
     symmetry_planes,
 )
 from fenics_contact.model.state import ContactState
+
+#: A held node's slip along its held tangent counts as prescribed motion above this
+#: fraction of the contact surface's extent (below: the support holds it still).
+HELD_SLIP_FLOOR = 1e-12
 
 
 class CoulombFriction:
@@ -83,15 +88,19 @@ class CoulombFriction:
         self.r_t: ufl.core.expr.Expr = ufl.min_value(contact.r, self.r_t_cap)
         self.trial_traction = lam_t + self.r_t * self.slip
         self.coulomb_radius = -self.mu * contact.pressure
-        self.traction_t = ufl.elem_mult(
-            mask, coulomb_projection(self.trial_traction, self.coulomb_radius, self.eps)
-        )
+        #: 1 on each frame component along which a prescribed displacement holds the
+        #: node (rigid obstacles only, where the slip there is then data; 0 elsewhere).
+        self.held = fem.Function(self.Qt, name="held_tangent")
+        held = ufl.as_vector([self.held]) if gdim == 2 else self.held
+        self._prescribed_slip = ufl.dot(ufl.elem_mult(held, self.slip), self.slip)
+        self._slip_floor = fem.Constant(
+            domain, default_scalar_type((HELD_SLIP_FLOOR * self.contact_extent) ** 2))
+        self._mask = mask
+        self.traction_t = self._projected(self.coulomb_radius)
         self._lam_t_vector = lam_t
         # penalty: regularised stick on the committed traction, rho = mu r max(-g, 0)
         self._penalty_radius = -self.mu * ufl.min_value(contact.r * contact.gap, 0.0)
-        self.penalty_traction = ufl.elem_mult(
-            mask, coulomb_projection(self.trial_traction, self._penalty_radius, self.eps)
-        )
+        self.penalty_traction = self._projected(self._penalty_radius)
 
         k = gdim - 1
         nodal = surface.nodal_integrand
@@ -99,10 +108,11 @@ class CoulombFriction:
         # The reported tangential traction of a multiplier strategy: the converged
         # multiplier lam_t (= tau at convergence), free of the round-off r eps g that
         # the Coulomb radius -mu min(lam + r g, 0) carries at a huge user r.
-        multiplier = ufl.elem_mult(mask, lam_t)
+        multiplier = self._projected(None, lam_t)
         (self._tau_forms, self._pen_forms, self._slip_forms, self._y_forms, self._rho_form,
          self._global_forms, self._tforce_forms, self._tmag_form, self._multiplier_forms,
-         self._multiplier_force_forms, self._multiplier_mag_form) = surface.compile([
+         self._multiplier_force_forms, self._multiplier_mag_form,
+         self._prescribed_slip_form) = surface.compile([
             [nodal(self.traction_t[i]) for i in range(k)],
             [nodal(self.penalty_traction[i]) for i in range(k)],
             [nodal(self.slip[i]) for i in range(k)],
@@ -116,11 +126,41 @@ class CoulombFriction:
              [nodal(-(self.tangents * multiplier)[i]) for i in range(gdim)]],
             [(self.tangents * multiplier)[i] * surface.ds for i in range(gdim)],
             ufl.sqrt(ufl.dot(multiplier, multiplier)) * surface.ds,
+            nodal(self._prescribed_slip) if self._slip_is_data else None,
         ])
         self.symmetry_constraints = self._constrain_symmetry_planes()
 
+    @property
+    def _slip_is_data(self) -> bool:
+        """Whether the slip along a held tangent is data (a rigid partner) at this contact."""
+        return bool(getattr(self.contact, "held_slip_is_data", False))
+
+    def _projected(self, rho: ufl.core.expr.Expr | None,
+                   lam_t: ufl.core.expr.Expr | None = None) -> ufl.core.expr.Expr:
+        """The Coulomb projection P(y) on the disc of radius ``rho``, held tangents treated.
+
+        Where a symmetry plane holds the node the traction across it is zero
+        (:attr:`symmetry_mask`). Against a rigid obstacle a prescribed
+        displacement along a tangent makes that slip data: zero, and the
+        traction along the held tangent is left to the support (masked), or
+        not zero, and the node cannot stick (the stick branch would be a
+        zero Jacobian row), so it slides: tau = rho y / |y| whatever |y|.
+        With ``lam_t`` instead of ``rho``: the multiplier under the same rule
+        (what the outputs report).
+        """
+        y = self.trial_traction
+        if lam_t is None:
+            standard = ufl.elem_mult(self._mask, coulomb_projection(y, rho, self.eps))
+            sliding = rho / ufl.sqrt(ufl.dot(y, y) + self.eps**2) * y
+        else:
+            standard, sliding = ufl.elem_mult(self._mask, lam_t), lam_t
+        if not self._slip_is_data:
+            return standard
+        forced = ufl.conditional(ufl.gt(self._prescribed_slip, self._slip_floor), 1.0, 0.0)
+        return forced * sliding + (1.0 - forced) * standard
+
     def _constrain_symmetry_planes(self) -> int:
-        """Zero the traction across every symmetry plane at the contact nodes it holds.
+        """Mask the traction along held tangents at the contact nodes (symmetry planes).
 
         A symmetry plane is a Dirichlet condition holding one displacement
         component at 0 on a plane of facets normal to that axis (see
@@ -131,11 +171,19 @@ class CoulombFriction:
         and :attr:`symmetry_mask` makes it so (residual row lam_t,k = 0, no
         force). The frame component along the plane's normal is found from
         the nodal tangents; a frame not aligned with the plane is refused.
-        Returns the number of constrained (node, component) pairs (global).
+
+        Against a rigid obstacle every held displacement component along a
+        tangent of the frame is treated alike, whatever its value, and also
+        marked in :attr:`held`: where the obstacle moves along it the node
+        slides (:meth:`_projected`). Returns the number of constrained
+        (node, component) pairs (global).
         """
         domain = self.contact.domain
-        planes = symmetry_planes(domain, self.contact.solid.prescribed)
-        if not planes:
+        holds = [(facets, axis, True) for facets, axis
+                 in symmetry_planes(domain, self.contact.solid.prescribed)]
+        if self._slip_is_data:
+            holds += [(f, a, False) for f, a in held_components(self.contact.solid.prescribed)]
+        if not self.comm.allreduce(len(holds), op=MPI.MAX):
             return 0
         fdim = domain.topology.dim - 1
         W = fem.functionspace(domain, ("Lagrange", 1))
@@ -150,25 +198,32 @@ class CoulombFriction:
             np.column_stack([self.surface.nodal(compiled[i][j]) for j in range(k)])
             for i in range(self.gdim)
         ], axis=1)  # (owned nodes, gdim, d-1)
-        count = 0
-        for facets, axis in planes:
+        constrained = np.zeros((n_owned, k), dtype=bool)
+        for facets, axis, symmetric in holds:
             held = fem.locate_dofs_topological(W, fdim, facets)
             nodes = np.flatnonzero(np.isin(parent[:n_owned], held))
             along = np.abs(frame[nodes, axis, :])
             j = np.argmax(along, axis=1) if nodes.size else np.zeros(0, int)
-            worst = float(np.min(along[np.arange(nodes.size), j], initial=1.0))
-            worst = self.comm.allreduce(worst, op=MPI.MIN)
-            if worst < 1.0 - 1e-8:
-                raise ValueError(
-                    f"A symmetry plane (u_{'xyz'[axis]} = 0 on a plane normal to "
-                    f"{'xyz'[axis]}) crosses the frictional contact surface where the contact "
-                    f"normal is not in the plane (|t . e_{'xyz'[axis]}| = {worst:.3g}); a "
-                    "symmetry cut needs the contact normal in the plane there."
-                )
-            self.symmetry_mask.x.array[nodes * k + j] = 0.0
-            count += self.comm.allreduce(int(nodes.size), op=MPI.SUM)
+            aligned = along[np.arange(nodes.size), j] >= 1.0 - 1e-8
+            if symmetric:
+                worst = float(np.min(along[np.arange(nodes.size), j], initial=1.0))
+                worst = self.comm.allreduce(worst, op=MPI.MIN)
+                if worst < 1.0 - 1e-8:
+                    raise ValueError(
+                        f"A symmetry plane (u_{'xyz'[axis]} = 0 on a plane normal to "
+                        f"{'xyz'[axis]}) crosses the frictional contact surface where the "
+                        f"contact normal is not in the plane (|t . e_{'xyz'[axis]}| = "
+                        f"{worst:.3g}); a symmetry cut needs the contact normal in the plane "
+                        "there.")
+            # a held axis across the frame leaves the slip free along the tangents: no
+            # zero Jacobian row, nothing to treat
+            constrained[nodes[aligned], j[aligned]] = True
+        self.symmetry_mask.x.array[: n_owned * k] = np.where(constrained.reshape(-1), 0.0, 1.0)
         self.symmetry_mask.x.scatter_forward()
-        return count
+        if self._slip_is_data:
+            self.held.x.array[: n_owned * k] = constrained.reshape(-1).astype(float)
+            self.held.x.scatter_forward()
+        return self.comm.allreduce(int(np.sum(constrained)), op=MPI.SUM)
 
     # -- the tangential parameter --------------------------------------------------------
     @property
@@ -263,6 +318,10 @@ class CoulombFriction:
         stick = sticks(y, rho, float(self.eps.value))
         state = np.full(rho.size, OPEN, dtype=np.int8)
         active = pressure < 0.0
+        if self._slip_is_data:
+            # a held node that the obstacle drags along its held tangent slides
+            stick &= ~(self.surface.nodal(self._prescribed_slip_form)
+                       > float(self._slip_floor.value))
         state[active] = np.where(stick[active], STICK, SLIP)
         return state, y
 

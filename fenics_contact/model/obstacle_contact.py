@@ -61,6 +61,8 @@ class ObstacleContact(Contact):
         name: label in outputs.
     """
 
+    held_slip_is_data = True
+
     def __init__(
         self,
         obstacle: RigidObstacle,
