@@ -358,6 +358,19 @@ def test_dirichlet_bounds_selecting_nothing(tmp_path):
 
 
 @pytest.mark.mpi
+def test_two_supports_disagreeing_at_a_shared_node(tmp_path):
+    """The top pushed down and the left side clamped share the top-left corner."""
+    scene = base()
+    scene["dirichlet"].append({"tag": "left", "value": [0.0, 0.0]})
+    with pytest.raises(SceneError, match=re.escape(
+            "hold u_y at the node [0.0, 0.5] with different values: 'top' gives -0.05 and "
+            "'left' gives 0.0")):
+        _build(write(tmp_path, scene))
+    scene["dirichlet"][1]["value"] = [0.0, "free"]  # agree on x at the corner: accepted
+    _build(write(tmp_path, scene))
+
+
+@pytest.mark.mpi
 @pytest.mark.parametrize(
     ("dirichlet", "free"),
     [
@@ -422,8 +435,9 @@ def test_initial_penetration_beyond_facet_size_warns(tmp_path):
 @pytest.mark.parametrize("change, fix", [
     (edit(obstacle__normal=[0.0, -1.0]), r"normal = \[0.0, 1.0\]\?"),
     (edit(obstacle={"type": "ball", "centre": [0.5, -1.0], "radius": 1.0, "inside": True}),
-     r"check 'inside'"),
-], ids=["plane", "ball"])
+     r"or inside = true should go"),
+    (edit(contact__tag="top"), r"tag the face that meets it"),
+], ids=["plane", "ball", "tag"])
 def test_obstacle_no_candidate_facet_faces_is_refused(tmp_path, change, fix):
     """A plane normal given the wrong way round: the body sits inside the obstacle's side."""
     with pytest.raises(SceneError, match=r"\[\[obstacle\]\] 'obstacle': none of its candidate "
@@ -574,8 +588,8 @@ def test_pair_facets_inside_the_mesh_are_refused(tmp_path):
 @pytest.mark.mpi
 def test_floating_body_of_a_pair_is_named(tmp_path):
     text = BLOCKS.replace('[[dirichlet]]\ntag = "bottom"\nvalue = ["free", 0.0]\n', "")
-    with pytest.raises(SceneError, match=r"\[\[body\]\] 'lower': no \[\[dirichlet\]\] condition "
-                       r"holds its rigid motions \(translation in y\), and its contacts do not"):
+    with pytest.raises(SceneError, match=r"\[\[body\]\] 'lower' can move rigidly \(translation "
+                       r"in y\): no \[\[dirichlet\]\] condition holds that motion"):
         _build(_blocks(tmp_path, text))
 
 

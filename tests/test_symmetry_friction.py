@@ -224,6 +224,7 @@ def test_a_held_side_on_a_sliding_plane_slides_at_the_coulomb_limit(tmp_path):
     assert len(steps) == scene.solver.steps
     problem = outcome.problem
     assert problem.symmetry_constraints == 1  # the corner: left side and plane
+    assert problem.contacts[0].normal_mask is None  # held across the normal: its gap is free
     for step in steps:
         if step.load_factor <= 0.4:  # pressed, not dragged: nothing slides, no friction
             assert step.tangential_force <= 1e-10 * step.contact_force

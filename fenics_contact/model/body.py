@@ -317,7 +317,44 @@ class Solid:
                 const = fem.Constant(self.domain, default_scalar_type(0.0))
                 self._bc_constants.append((const, condition, i))
                 bcs.append(fem.dirichletbc(const, dofs, Vi))
+        self._check_conflicts(bcs)
         return bcs
+
+    def _check_conflicts(self, bcs: Sequence[fem.DirichletBC]) -> None:
+        """Refuse two conditions that give one node's component different values (collective).
+
+        Compared at every knot of the load path (paths) and at t = 1; one of
+        them would silently win and the other be reported as not met.
+        """
+        times = sorted({1.0, *(float(k[0]) for c in self.prescribed
+                                for k in getattr(c, "path", ()))})
+        seen: dict[int, tuple[int, np.ndarray]] = {}
+        clash = None
+        for k, ((_, condition, i), bc) in enumerate(zip(self._bc_constants, bcs, strict=True)):
+            values = np.array([condition.at(t)[i] for t in times])
+            dofs, _ = bc.dof_indices()
+            for dof in dofs.tolist():
+                other = seen.setdefault(dof, (k, values))
+                if other[0] != k and not np.allclose(other[1], values, rtol=1e-12, atol=0.0):
+                    clash = (other[0], k, dof)
+                    break
+            if clash:
+                break
+        found = self.comm.allgather(None if clash is None else self._describe_clash(*clash))
+        message = next((m for m in found if m is not None), None)
+        if message is not None:
+            raise ValueError(message)
+
+    def _describe_clash(self, first: int, second: int, dof: int) -> str:
+        """The message for two conditions that disagree at the (blocked-unrolled) dof."""
+        (_, a, i), (_, b, _) = self._bc_constants[first], self._bc_constants[second]
+        point = self.V.tabulate_dof_coordinates()[dof // self.gdim][: self.gdim]
+        names = [repr(c.name) if c.name else f"{c.value}" for c in (a, b)]
+        return (f"Two prescribed displacements hold u_{'xyz'[i]} at the node "
+                f"{(np.round(point, 6) + 0.0).tolist()} with different values: {names[0]} gives "
+                f"{a.at(1.0)[i]} and {names[1]} gives {b.at(1.0)[i]} at the end of the load "
+                "path. A node shared by two supports takes one value: restrict one of them "
+                "(e.g. its coordinate range) or leave that component free in one.")
 
     def symmetry_plane_axes(self) -> tuple[fem.Function, fem.Function] | None:
         """The symmetry planes' nodal data (:func:`~.friction.plane_axes`; None without).

@@ -102,6 +102,8 @@ class Contact:
         self.gap = self._bind_partner(solid)
         self.set_r(self.settings.r, relative=self.settings.relative)
         self.pressure = augmented_pressure(self.gap, self.lam, self.r)
+        if self.normal_mask is not None:
+            self.pressure = self.normal_mask * self.pressure
         nodal = self.surface.nodal_integrand
         (self._gap_form, self._pressure_form, self._force_form,
          self._multiplier_force_form) = self.surface.compile([
@@ -121,6 +123,9 @@ class Contact:
     modulus: float
     #: The node-to-segment search of a deformable pair; None against a rigid obstacle.
     pair = None
+    #: 0 at the nodes whose gap a prescribed displacement fixes (they transmit no
+    #: pressure; the support holds them), 1 elsewhere; None: every node is free.
+    normal_mask: fem.Function | None = None
 
     # -- parameters and loads ----------------------------------------------------------
     @property
@@ -170,12 +175,23 @@ class Contact:
 
     # -- UFL terms ------------------------------------------------------------------------
     def lagrangian(self) -> ufl.Form:
-        """Int [min(lam + r g, 0)^2 - lam^2] / (2 r) ds (paper eq. 9)."""
-        return augmented_lagrangian_energy(self.gap, self.lam, self.r) * self.surface.ds
+        """Int [min(lam + r g, 0)^2 - lam^2] / (2 r) ds (paper eq. 9).
+
+        With a :attr:`normal_mask` m: [m min(lam + r g, 0)^2 - lam^2] / (2 r),
+        so that lam = 0 at a masked node (a regular row) and it exerts nothing.
+        """
+        if self.normal_mask is None:
+            return augmented_lagrangian_energy(self.gap, self.lam, self.r) * self.surface.ds
+        m = self.normal_mask
+        return ((m * ufl.min_value(self.lam + self.r * self.gap, 0) ** 2 - self.lam**2)
+                / (2 * self.r) * self.surface.ds)
 
     def penalty(self) -> ufl.Form:
-        """Int r/2 min(g, 0)^2 ds (paper eq. 7)."""
-        return penalty_energy(self.gap, self.r) * self.surface.ds
+        """Int r/2 min(g, 0)^2 ds (paper eq. 7); times the :attr:`normal_mask` if any."""
+        energy = penalty_energy(self.gap, self.r)
+        if self.normal_mask is not None:
+            energy = self.normal_mask * energy
+        return energy * self.surface.ds
 
     def complementarity_residual(self) -> ufl.Form:
         """(min(lam + r g, 0) - lam) mu: zero when lam is the converged pressure."""

@@ -36,6 +36,8 @@ import numpy as np
 from scipy.sparse import coo_matrix, csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
+from mpi4py import MPI
+
 from fenics_contact.model.pairs import DeformablePair
 from fenics_contact.model.search import KEEP, TIE_TOL, Projection, facet_normals, project
 
@@ -229,6 +231,10 @@ class SelfContactPair(DeformablePair):
                                        self.neighbourhood)[:, :m]
         self._X_union = X
         self._lift_length = 100.0 * float(np.ptp(X, axis=0).max(initial=1.0))
+        shared = np.intersect1d(np.asarray(target_facets), np.asarray(striker_facets)).size
+        #: Whether striker and target are two surfaces (two bodies paired automatically, or
+        #: two faces of one body): the depth inside the target is then its closest point's.
+        self.two_surfaces = not V.mesh.comm.allreduce(int(shared), op=MPI.SUM)
 
     def _lift_past_rim(self, points, current, proj) -> None:
         """Nothing here: :meth:`_search` lifts the nodes no facet qualifies for."""
@@ -242,13 +248,19 @@ class SelfContactPair(DeformablePair):
         return proj
 
     def penetration(self) -> np.ndarray:
-        """Depth of each owned striker node behind its assigned facet's plane (length, >= 0).
+        """Depth of each owned striker node inside the target (length, >= 0).
 
-        Measured on the assigned (facing) facet: the closest point of the whole
-        surface to a node on it is the node itself. A node kept past the end
-        of its facet at a concave corner of the wall (the hysteresis) can lie
-        inside the next facet while in front of this plane (docs/contacts.md).
+        Two surfaces (:attr:`two_surfaces`): the closest point over the whole
+        target surface, as for a declared pair, so that a node held on the
+        extension of a facet past a concave vertex counts as inside the next
+        facet. One surface against itself: measured on the assigned (facing)
+        facet, since the closest point of the whole surface to a node on it
+        is the node itself; a node kept past the end of its facet at a
+        concave corner of the wall (the hysteresis) can lie inside the next
+        facet while in front of this plane (docs/contacts.md).
         """
+        if self.two_surfaces:
+            return super().penetration()
         n = self.n_owned
         current = (self.X_vertices + self.target_displacements())[self.facet_vertex]
         facet = self.assignment[:n]

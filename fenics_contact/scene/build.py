@@ -373,14 +373,25 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
               for p in scene.pairs} if scene.pairing else set()
     contacts += pairing_contacts(scene, body.domain, body.cell_tags, bodies, paired)
     contacts += [obstacle_contact(scene, body, entry, bodies) for entry in scene.obstacles]
-    solid = Solid(body.domain, bodies, body.cell_tags, prescribed=prescribed,
-                  tractions=tractions)
+    solid = _solid(scene, body.domain, bodies, body.cell_tags, prescribed=prescribed,
+                   tractions=tractions)
     problem = ContactProblem(solid, contacts)
     check_obstacles_face_their_facets(scene, problem)
     check_bodies_held(scene, problem, body.cell_tags, bodies, prescribed)
     check_initial_overlap(scene, problem)
     warn_initial_penetration(scene, problem)
     return problem
+
+
+def _solid(scene: Scene, *args, **kwargs) -> Solid:
+    """The scene's :class:`Solid`, its refusals of the conditions as scene errors.
+
+    (Two supports that disagree at a node, a support that holds no facet.)
+    """
+    try:
+        return Solid(*args, **kwargs)
+    except ValueError as exc:
+        raise SceneError(f"{scene.path.name}: {exc}") from None
 
 
 def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProblem:
@@ -397,8 +408,9 @@ def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProbl
     prescribed, tractions = boundary_conditions(scene, body)
     free = free_rigid_motions(body.domain, [(p.facets, p.at(1.0)) for p in prescribed])
     warn_locking(scene, scene.nu, "[material]")
-    solid = Solid(body.domain, [Body("body", None, material(scene.law, scene.E, scene.nu))],
-                  prescribed=prescribed, tractions=tractions)
+    solid = _solid(scene, body.domain,
+                   [Body("body", None, material(scene.law, scene.E, scene.nu))],
+                   prescribed=prescribed, tractions=tractions)
     contacts = [obstacle_contact(scene, body, entry) for entry in scene.obstacles]
     problem = ContactProblem(solid, contacts)
     check_obstacles_face_their_facets(scene, problem)
