@@ -69,6 +69,17 @@ def test_a_stack_without_its_floor_is_refused_naming_the_free_block(tmp_path):
     text = SCENE.read_text()
     floor = text[text.index("[[obstacle]]"):text.index("[[dirichlet]]")]
     path = variant(tmp_path, floor, "")
-    with pytest.raises(SceneError, match=r"\[\[body\]\] 'bottom': no \[\[dirichlet\]\] condition "
-                       r"holds its rigid motions \(translation in y\)"):
+    with pytest.raises(SceneError, match=r"\[\[body\]\] 'bottom' can move rigidly "
+                       r"\(translation in y\): no \[\[dirichlet\]\] condition holds that motion"):
+        build_problem(load_scene(path), MPI.COMM_SELF)
+
+
+def test_the_block_left_free_is_the_one_named(tmp_path):
+    """The symmetry plane kept on the lower and upper blocks only: the middle block, held
+    in y by its neighbours, slides in x (before, the message named the bottom block)."""
+    path = variant(tmp_path, '[[dirichlet]]\ntag = "symmetry"\nvalue = [0.0, "free"]\n',
+                   '[[dirichlet]]\ntag = "symmetry"\ny = [0.0, 0.4]\nvalue = [0.0, "free"]\n'
+                   '[[dirichlet]]\ntag = "symmetry"\ny = [0.8, 1.2]\nvalue = [0.0, "free"]\n')
+    with pytest.raises(SceneError, match=r"\[\[body\]\] 'middle' can move rigidly "
+                       r"\(translation in x\).*on a face of 'middle'"):
         build_problem(load_scene(path), MPI.COMM_SELF)

@@ -152,6 +152,19 @@ def assembly_held(
 ) -> bool:
     """Whether the Dirichlet conditions and the contacts closed at the start hold every body.
 
+    See :func:`free_assembly_motion`; True when it finds no free motion. Collective.
+    """
+    return not free_assembly_motion(domain, bodies, conditions, contact_gaps)
+
+
+def free_assembly_motion(
+    domain: mesh.Mesh,
+    bodies: Sequence[tuple[str, np.ndarray]],
+    conditions: Sequence[tuple[np.ndarray, Sequence[float | None]]],
+    contact_gaps: Callable[[np.ndarray], np.ndarray],
+) -> list[tuple[str, str]]:
+    """A rigid motion of the assembly that nothing holds, body by body ([] when held).
+
     Each body may move rigidly on its own. A Dirichlet component holds the
     body whose facets carry it both ways. A contact node whose gap is zero
     at the start resists only the motions that close it (the gap is
@@ -170,7 +183,9 @@ def assembly_held(
             displacement given per geometry node, shape (nodes, gdim) (length).
 
     Returns:
-        True when no rigid motion of the assembly is free. Collective.
+        (body name, its part of the motion in words) for each body that the
+        free motion found moves; empty when every rigid motion is held.
+        Collective.
     """
     from scipy.optimize import linprog
 
@@ -206,7 +221,7 @@ def assembly_held(
     eigenvalues, vectors = np.linalg.eigh(total)
     free = vectors[:, eigenvalues <= 1e-10 * max(float(eigenvalues.max()), 1.0)]
     if free.shape[1] == 0:
-        return True
+        return []
     # d gap / d mode at the closed nodes, for the modes the conditions leave free
     step = 1e-7 * size
     base = contact_gaps(np.zeros_like(x))
@@ -234,8 +249,29 @@ def assembly_held(
                              b_ub=np.full(resist.shape[0], 1e-9) if resist.size else None,
                              bounds=[(-1.0, 1.0)] * k, method="highs")
             if result.status == 0 and -result.fun > 1e-3:
-                return False
-    return True
+                return _moving_bodies(free @ result.x, bodies, centre, size, gdim)
+    return []
+
+
+def _moving_bodies(mode: np.ndarray, bodies: Sequence[tuple[str, np.ndarray]],
+                   centre: np.ndarray, size: float, gdim: int) -> list[tuple[str, str]]:
+    """Each body that a rigid motion of the assembly (modes per body, scaled) moves, in words."""
+    n_modes = 3 if gdim == 2 else 6
+    parts = mode.reshape(len(bodies), n_modes)
+    scale = float(np.max(np.linalg.norm(parts, axis=1)))
+    out = []
+    names = _names(gdim)
+    for (name, _), part in zip(bodies, parts, strict=True):
+        if np.linalg.norm(part) <= 1e-3 * scale:
+            continue
+        part = part / np.linalg.norm(part)
+        part = np.where(np.abs(part) < 1e-6, 0.0, part)  # the linear program's round-off
+        pure = np.flatnonzero(part)
+        if pure.size == 1 and "translation" in names[pure[0]]:
+            out.append((name, names[pure[0]]))
+        else:
+            out.append((name, _describe(part, centre, size, gdim)))
+    return out
 
 
 def _reduce(comm: MPI.Comm, x: np.ndarray, local: Callable, op: MPI.Op) -> np.ndarray:

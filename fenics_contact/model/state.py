@@ -99,16 +99,19 @@ class ContactState:
         """
         if active is None:
             active = pressure < 0.0
+        active_count = comm.allreduce(int(active.sum()), op=MPI.SUM)
+        force = comm.allreduce(local_force, op=MPI.SUM)
         return cls(
             gap=gap,
             pressure=pressure,
             multiplier=multiplier,
             active=active,
-            active_count=comm.allreduce(int(active.sum()), op=MPI.SUM),
+            active_count=active_count,
             max_penetration=comm.allreduce(
                 float(np.max(-np.minimum(gap, 0.0), initial=0.0)) + 0.0, op=MPI.MAX
             ),
-            contact_force=comm.allreduce(local_force, op=MPI.SUM),
+            # no node in contact: the force of the round-off multipliers (1e-207) is none
+            contact_force=force if active_count else 0.0,
         )
 
 

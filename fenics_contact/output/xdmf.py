@@ -130,7 +130,10 @@ class StepWriter:
     von Mises stress). With friction also tangential_traction (the tangential
     traction the obstacle puts on the body, P1 vector, stress), slip (the
     slip increment of the load step relative to the obstacle, P1 vector,
-    length) and stick_slip (0 open, 1 stick, 2 slip). Time is the load
+    length) and stick_slip (0 open, 1 stick, 2 slip); a frictionless
+    contact of such a scene writes 2 at its closed nodes (nothing holds
+    them along the surface) and zero traction and slip (its slip is not
+    measured), and the summary counts neither. Time is the load
     factor. After each step the index
     ``path`` (an XDMF temporal collection) names every step written so far.
 

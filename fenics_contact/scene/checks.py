@@ -19,7 +19,7 @@ from mpi4py import MPI
 
 from fenics_contact.model.mortar import MortarContact
 from fenics_contact.model.problem import PrescribedDisplacement
-from fenics_contact.model.rigid import assembly_held, free_rigid_motions
+from fenics_contact.model.rigid import free_assembly_motion, free_rigid_motions
 from fenics_contact.scene.schema import PairSpec, Scene, SceneError
 
 if TYPE_CHECKING:
@@ -302,13 +302,17 @@ def check_obstacles_face_their_facets(scene: Scene, problem: ContactProblem) -> 
             continue
         if comm.allreduce(bool(np.any(facing)), op=MPI.LOR):
             continue
+        tag = "the contact's tag names the face turned away from the obstacle (tag the face"
         if isinstance(contact.obstacle, RigidPlane):
             flipped = [float(-v) + 0.0 for v in contact.obstacle.normal.value]
-            fix = (f"a plane's normal points out of the obstacle, towards the body: "
-                   f"normal = {flipped}?")
+            fix = (f"either {tag} that meets it), or the plane's normal points into the "
+                   f"obstacle: it points out of it, towards the body: normal = {flipped}?")
+        elif contact.obstacle.inside:
+            fix = (f"either {tag} that meets it), or inside = true should go: it keeps the "
+                   "body inside the ball (a cradle).")
         else:
-            fix = ("a ball keeps the body outside it unless inside = true (a cradle): "
-                   "check 'inside'.")
+            fix = (f"either {tag} that meets it), or the ball is a cradle that holds the "
+                   "body inside it: inside = true.")
         raise SceneError(
             f"{scene.path.name}: [[obstacle]] {contact.name!r}: none of its candidate facets "
             f"faces it (their outward normals all point along the obstacle's normal), so "
@@ -340,17 +344,22 @@ def check_bodies_held(
     if not free:
         return
     cells = [(b.name, cell_tags.find(b.tag)) for b in bodies]
-    if held_by_closed_contacts(problem, cells, prescribed):
+    moving = free_motion_of_contacts(problem, cells, prescribed)
+    if not moving:
         return
-    name, motions = free[0]
+    name = moving[0][0]
+    if len(moving) == 1:
+        what = f"[[body]] {name!r} can move rigidly ({moving[0][1]})"
+    else:
+        what = ("[[body]] " + " and ".join(repr(m[0]) for m in moving) + " can move rigidly "
+                "together (" + "; ".join(f"{n!r}: {m}" for n, m in moving) + ")")
     raise SceneError(
-        f"{scene.path.name}: [[body]] {name!r}: no [[dirichlet]] condition holds "
-        f"its rigid motions ({'; '.join(motions)}), and its contacts do not hold them at the "
-        f"start: one open, or touching with no pressure yet, holds nothing before the load "
-        f"presses it (nor along it: friction is not counted as a support). Fix: prescribe "
-        f"components on a face of {name!r} (e.g. a support, a symmetry plane or a driven "
-        "face: a prescribed displacement instead of a traction), or start it touching the "
-        "parts that hold it."
+        f"{scene.path.name}: {what}: no [[dirichlet]] condition holds that motion, and the "
+        f"contacts do not hold it at the start: one open, or touching with no pressure yet, "
+        f"holds nothing before the load presses it (nor along it: friction is not counted "
+        f"as a support). Fix: prescribe components on a face of {name!r} (e.g. a support, a "
+        "symmetry plane or a driven face: a prescribed displacement instead of a traction), "
+        "or start it touching the parts that hold it."
     )
 
 
@@ -359,7 +368,18 @@ def held_by_closed_contacts(
     bodies: Sequence[tuple[str, np.ndarray]],
     prescribed: Sequence[PrescribedDisplacement],
 ) -> bool:
-    """Whether the conditions and the contacts closed at load 0 hold every body (see rigid.py).
+    """Whether the conditions and the contacts closed at load 0 hold every body (see rigid.py)."""
+    return not free_motion_of_contacts(problem, bodies, prescribed)
+
+
+def free_motion_of_contacts(
+    problem: ContactProblem,
+    bodies: Sequence[tuple[str, np.ndarray]],
+    prescribed: Sequence[PrescribedDisplacement],
+) -> list[tuple[str, str]]:
+    """A rigid motion that neither the conditions nor the contacts closed at load 0 hold.
+
+    (body name, its part of the motion) per moving body; [] when held (see rigid.py).
 
     Evaluates each contact's gaps for rigid motions of the bodies (u is put
     back to zero afterwards). Collective.
@@ -376,7 +396,8 @@ def held_by_closed_contacts(
         return np.concatenate([c.contact_state().gap for c in problem.contacts])
 
     try:
-        return assembly_held(domain, bodies, [(p.facets, p.at(1.0)) for p in prescribed], gaps)
+        return free_assembly_motion(domain, bodies, [(p.facets, p.at(1.0)) for p in prescribed],
+                                    gaps)
     finally:
         u.x.array[:] = 0.0
         problem.refresh_search()
