@@ -25,6 +25,7 @@ from fenics_contact.output.xdmf import StepWriter, finished_steps, step_files
 from fenics_contact.scene.body_overlap import warn_body_overlap
 from fenics_contact.scene.build import build_problem
 from fenics_contact.scene.checks import warn_untagged_penetration
+from fenics_contact.scene.pressure_scatter import warn_pressure_scatter
 from fenics_contact.scene.schema import Scene
 from fenics_contact.scene.striker_advice import advise_striker
 from fenics_contact.solvers import make_strategy
@@ -313,6 +314,7 @@ def run_scene(
     warn_untagged_penetration(scene, problem)
     warn_body_overlap(scene, problem)
     advise_striker(scene, problem)
+    warn_pressure_scatter(scene, problem)
     if not finished_steps(out / "solution.xdmf"):  # no step on disk: nothing to open
         if comm.rank == 0:
             (out / SCRIPT).unlink(missing_ok=True)

@@ -259,6 +259,11 @@ def test_the_tube_in_3d_follows_the_plane_strain_section(crushed, tmp_path):
     states = outcome.problem.contact_states()
     rows = crushed.problem.contact_states()["inner"].active_count
     assert abs(states["inner"].active_count - 2 * rows) <= 2  # measured 99 against 2 x 49
-    assert states["inner"].max_penetration <= 1e-8 * WALL
+    inner = states["inner"]
+    assert inner.constraint_penetration <= 1e-8 * WALL
+    # by closest point over the lower wall: nodes held on their facets past its bent edges,
+    # 5.7e-7 (5.5e-6 h) at most (measured)
+    h = next(c for c in outcome.problem.contacts if c.name == "inner").surface.h
+    assert inner.max_penetration <= 1e-5 * h
     top, bottom = states["top"].contact_force, states["bottom"].contact_force
     assert abs(top - bottom) <= 1e-10 * top

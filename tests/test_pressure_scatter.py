@@ -1,0 +1,51 @@
+"""The end-of-run warning for node-to-segment pressures that scatter from node to node."""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from mpi4py import MPI
+
+from fenics_contact import load_scene, run_scene
+from fenics_contact.scene.checks import SceneWarning
+from fenics_contact.scene.pressure_scatter import SCATTER, nodal_scatter
+
+SCENES = Path(__file__).parents[1] / "scenes"
+
+
+def _run(tmp_path, name: str):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", SceneWarning)
+        outcome = run_scene(load_scene(SCENES / name), tmp_path / name, comm=MPI.COMM_SELF,
+                            pictures=False)
+    assert outcome.path.converged
+    said = [str(w.message) for w in caught if "scatter from node to node" in str(w.message)]
+    return outcome, said
+
+
+def test_the_non_matching_patch_test_on_node_to_segment_is_named(tmp_path):
+    """Uniform pressure in truth; node-to-segment on 8 against 11 facets scatters it."""
+    outcome, said = _run(tmp_path, "block_on_block_node_to_segment.toml")
+    scatter, mean = nodal_scatter(outcome.problem.contacts[0])
+    assert mean > 0 and len(said) == 1
+    assert "[[pair]] 'pair1'" in said[0] and 'discretisation = "mortar"' in said[0]
+    median = float(np.median(scatter)) / mean
+    assert median > 1.5 * SCATTER  # 0.16 measured
+    assert f"by {median:.0%} of their mean" in said[0]
+
+
+def test_a_smooth_node_to_segment_profile_is_not(tmp_path):
+    """The two cylinders (Hertz) on node-to-segment: the profile bends, it does not scatter."""
+    outcome, said = _run(tmp_path, "two_cylinders_node_to_segment.toml")
+    scatter, mean = nodal_scatter(outcome.problem.contacts[0])
+    assert not said
+    assert scatter.size >= 5
+    assert float(np.median(scatter)) / mean < 0.6 * SCATTER  # 0.053 measured
+
+
+def test_rigid_obstacles_are_not_measured(tmp_path):
+    _, said = _run(tmp_path, "hertz_cylinder.toml")
+    assert not said
