@@ -432,6 +432,16 @@ def test_initial_penetration_beyond_facet_size_warns(tmp_path):
         _build(write(tmp_path, scene))
 
 
+def test_a_run_that_fails_after_starting_inside_an_obstacle_says_so_first(tmp_path, capsys):
+    scene = base()
+    scene["obstacle"]["point"] = [0.0, 0.6]  # the clamped top itself is 0.1 inside
+    scene["dirichlet"][0]["value"] = [0.0, 0.0]
+    code = main(["run", str(write(tmp_path, scene)), "--out", str(tmp_path / "out"), "--quiet"])
+    assert code == 1
+    assert ("To try: first the start: the body starts 0.6 inside the obstacle (2.4 h, the "
+            "warning at the start)") in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("change, fix", [
     (edit(obstacle__normal=[0.0, -1.0]), r"normal = \[0.0, 1.0\]\?"),
     (edit(obstacle={"type": "ball", "centre": [0.5, -1.0], "radius": 1.0, "inside": True}),

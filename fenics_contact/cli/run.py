@@ -143,7 +143,7 @@ def _solve(
         print(
             f"fenics-contact: load step {failed.step} of {steps} did not converge "
             f"({failed.message or failed.status}); {_kept(failed.step - 1, out)}"
-            f"{_advice(scene, failed.status)}",
+            f"{_advice(scene, failed.status, getattr(outcome.problem, 'initial_overlap', None))}",
             file=sys.stderr,
         )
         return 1
@@ -165,12 +165,19 @@ def _count(n: int, noun: str) -> str:
     return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
 
 
-def _advice(scene: Scene, status: str) -> str:
-    """What to try after a failed load step (nothing for a stop that is not the solver's)."""
+def _advice(scene: Scene, status: str, overlap: str | None = None) -> str:
+    """What to try after a failed load step (nothing for a stop that is not the solver's).
+
+    ``overlap``: the body's initial overlap with an obstacle, when it was warned
+    about; first on the list, since no solver setting mends it.
+    """
     if status not in ("cycling", "diverged", "max_iterations", "inverted"):
         return ""
     method = scene.solver.method
     tips = []
+    if overlap:
+        tips.append(f"first the start: {overlap}; place the obstacle so that the gap at "
+                    "load 0 is >= 0")
     if status == "max_iterations" and method in ("nua", "sua"):
         tips.append(f"a larger [solver] max_iterations (now {scene.solver.max_iterations}: "
                     f"{method.upper()} counts every multiplier update as an iteration and "

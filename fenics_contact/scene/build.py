@@ -462,6 +462,9 @@ def warn_initial_penetration(scene: Scene, problem: ContactProblem) -> float:
         if depth <= h:
             continue
         which = "the obstacle" if len(obstacles) == 1 else f"obstacle '{contact.name}'"
+        #: What a failed run's advice repeats: the body started deep inside an obstacle.
+        problem.initial_overlap = (f"the body starts {depth:.4g} inside {which} "
+                                   f"({depth / h:.3g} h, the warning at the start)")
         warnings.warn(
             SceneWarning(
                 f"{scene.path.name}: the body starts {depth:.4g} inside {which}, more "
