@@ -268,3 +268,73 @@ def test_a_held_face_on_a_sliding_plane_in_3d_with_a_symmetry_cut(tmp_path):
     assert np.hypot(total[0], total[1]) == pytest.approx(last.tangential_force, rel=1e-8)
     assert total[0] < -0.99 * last.tangential_force
     assert total[2] == pytest.approx(-last.contact_force, rel=1e-8)
+
+
+def test_a_support_held_obliquely_to_a_frictional_contact_is_refused(tmp_path):
+    """The face x = 0 held in y (a symmetry plane given the wrong component): at its
+    nodes under the ball the normal mixes y and z, so a sticking node has three contact
+    rows on two free components; the first linear solve failed at every cut-back."""
+    from fenics_contact.scene.build import build_problem
+    from fenics_contact.scene.spec import SceneError
+
+    path = tmp_path / "wrong.toml"
+    path.write_text(HEAD.format(name="wrong", origin="[0.0, 0.0, 0.0]", size="[0.5, 0.5, 0.5]",
+                                cells="[4, 4, 2]", steps=3)
+                    + INDENT + SYM_Y + SYM_X.replace('[0.0, "free", "free"]',
+                                                     '["free", 0.0, "free"]'))
+    with pytest.raises(SceneError, match=r"wrong.toml: The support 'xmin' holds u_y at \d+ "
+                       r"node\(s\) of the frictional contact 'obstacle' where the obstacle's "
+                       r"normal is neither along nor across y"):
+        build_problem(load_scene(path), MPI.COMM_SELF)
+
+
+WALL = """[scene]
+name = "inclined-wall"
+dimension = 3
+[mesh]
+generator = "box"
+size = [1.0, 1.0, 1.0]
+cells = [3, 3, 3]
+[material]
+law = "linear"
+E = 100.0
+nu = 0.3
+[[dirichlet]]
+tag = "xmin"
+value = [0.02, 0.015, "free"]
+[[dirichlet]]
+tag = "zmin"
+value = ["free", "free", 0.0]
+[obstacle]
+type = "plane"
+point = [1.0, 1.0, 0.0]
+normal = [-0.8, -0.6, 0.0]
+[contact]
+tag = "xmax"
+mu = 0.3
+[solver]
+method = "gnrm"
+steps = 4
+[output]
+pictures = false
+"""
+
+
+def test_a_roller_face_against_an_inclined_wall_with_friction(tmp_path):
+    """The face z = 0 held in z meets a wall whose normal (-0.8, -0.6, 0) lies in that
+    face's plane: u_z is a tangent there, but neither of Duff's tangents (e_z . t = 0.8
+    and 0.6). The frame at those nodes is (e_z, n x e_z); before, the scene was refused
+    ("the contact normal is not in the plane")."""
+    path = tmp_path / "wall.toml"
+    path.write_text(WALL)
+    outcome = run_scene(load_scene(path), tmp_path / "out", comm=MPI.COMM_SELF)
+    assert outcome.path.status == "converged", outcome.path.steps[-1].message
+    problem = outcome.problem
+    state = problem.contact_state()
+    n = np.array([-0.8, -0.6, 0.0])
+    friction = -problem.tangential_force_vector()  # on the body
+    assert abs(friction @ n) < 1e-10 * state.contact_force
+    assert state.tangential_magnitude > 0.05 * state.contact_force
+    # the supports hold the body against the wall's push and friction
+    np.testing.assert_allclose(problem.support_total() + state.contact_force * n + friction,
+                               0.0, atol=1e-8 * state.contact_force)

@@ -95,6 +95,16 @@ def tangent_basis(n: ufl.core.expr.Expr, gdim: int) -> ufl.core.expr.Expr:
     return ufl.as_matrix([[t1[i], t2[i]] for i in range(3)])
 
 
+def tangent_basis_value(n: np.ndarray) -> np.ndarray:
+    """:func:`tangent_basis` in numpy for unit normals of shape (m, 3): shape (m, 3, 2)."""
+    s = np.where(n[:, 2] >= 0.0, 1.0, -1.0)
+    a = -1.0 / (s + n[:, 2])
+    b = n[:, 0] * n[:, 1] * a
+    t1 = np.column_stack([1.0 + s * n[:, 0] ** 2 * a, s * b, -s * n[:, 0]])
+    t2 = np.column_stack([b, s + n[:, 1] ** 2 * a, -n[:, 1]])
+    return np.stack([t1, t2], axis=2)
+
+
 def symmetry_planes(
     domain: mesh.Mesh, conditions: Sequence[object]
 ) -> list[tuple[np.ndarray, int]]:
@@ -128,8 +138,11 @@ def symmetry_planes(
     return planes
 
 
-def held_components(conditions: Sequence[object]) -> list[tuple[np.ndarray, int]]:
-    """(facets, axis) of every displacement component a Dirichlet condition holds."""
+def held_components(conditions: Sequence[object]) -> list[tuple[np.ndarray, int, str]]:
+    """(facets, axis, name) of every displacement component a Dirichlet condition holds.
+
+    ``name``: the condition's name, or its value where it has none.
+    """
     out = []
     for condition in conditions:
         value = condition.value  # type: ignore[attr-defined]
@@ -137,7 +150,8 @@ def held_components(conditions: Sequence[object]) -> list[tuple[np.ndarray, int]
         axes = range(len(path[0]) - 1) if path else [i for i, v in enumerate(value)
                                                       if v is not None]
         facets = np.asarray(condition.facets, dtype=np.int32)  # type: ignore[attr-defined]
-        out += [(facets, int(a)) for a in axes]
+        name = getattr(condition, "name", "") or str(list(value))
+        out += [(facets, int(a), name) for a in axes]
     return out
 
 

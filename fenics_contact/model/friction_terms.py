@@ -179,10 +179,10 @@ class CoulombFriction:
         (node, component) pairs (global).
         """
         domain = self.contact.domain
-        holds = [(facets, axis, True) for facets, axis
+        holds = [(facets, axis, None) for facets, axis
                  in symmetry_planes(domain, self.contact.solid.prescribed)]
         if self._slip_is_data:
-            holds += [(f, a, False) for f, a in held_components(self.contact.solid.prescribed)]
+            holds += held_components(self.contact.solid.prescribed)
         if not self.comm.allreduce(len(holds), op=MPI.MAX):
             return 0
         fdim = domain.topology.dim - 1
@@ -199,12 +199,17 @@ class CoulombFriction:
             for i in range(self.gdim)
         ], axis=1)  # (owned nodes, gdim, d-1)
         constrained = np.zeros((n_owned, k), dtype=bool)
-        for facets, axis, symmetric in holds:
+        mask = self.contact.normal_mask
+        free_gap = np.ones(n_owned, bool) if mask is None else mask.x.array[:n_owned] > 0.5
+        for facets, axis, name in holds:
+            symmetric = name is None
             held = fem.locate_dofs_topological(W, fdim, facets)
             nodes = np.flatnonzero(np.isin(parent[:n_owned], held))
             along = np.abs(frame[nodes, axis, :])
             j = np.argmax(along, axis=1) if nodes.size else np.zeros(0, int)
             aligned = along[np.arange(nodes.size), j] >= 1.0 - 1e-8
+            if not symmetric:
+                self._refuse_oblique_hold(nodes[free_gap[nodes]], axis, name)
             if symmetric:
                 worst = float(np.min(along[np.arange(nodes.size), j], initial=1.0))
                 worst = self.comm.allreduce(worst, op=MPI.MIN)
@@ -224,6 +229,32 @@ class CoulombFriction:
             self.held.x.array[: n_owned * k] = constrained.reshape(-1).astype(float)
             self.held.x.scatter_forward()
         return self.comm.allreduce(int(np.sum(constrained)), op=MPI.SUM)
+
+    def _refuse_oblique_hold(self, nodes: np.ndarray, axis: int, name: str) -> None:
+        """Refuse a held axis that is neither along nor across the obstacle's normal.
+
+        There the held direction mixes the normal and a tangent: the node has
+        fewer free components than the contact has rows (normal and stick),
+        and a sticking node gives the linear solve a singular matrix at once
+        (collective). Measured with the normal at load 0 at ``nodes`` (those
+        whose gap is free).
+        """
+        along = np.abs(self.contact.reference_normals()[nodes, axis])
+        oblique = (along > 1e-8) & (along < 1.0 - 1e-8)
+        count = self.comm.allreduce(int(np.sum(oblique)), op=MPI.SUM)
+        if not count:
+            return
+        X = self.contact.nodal_coordinates()[nodes[oblique]][:, : self.gdim]
+        where = self.comm.allgather(X[0].tolist() if X.shape[0] else None)
+        point = next(p for p in where if p is not None)
+        raise ValueError(
+            f"The support {name!r} holds u_{'xyz'[axis]} at {count} node(s) of the frictional "
+            f"contact {self.contact.name!r} where the obstacle's normal is neither along nor "
+            f"across {'xyz'[axis]} (e.g. at {np.round(point, 6).tolist()}): a sticking node "
+            "there has more contact conditions than free components, and the first linear "
+            "solve fails. A symmetry plane holds the component normal to its face (value = "
+            "[0.0, \"free\", ...] on the face x = 0); otherwise leave these nodes out of the "
+            "contact's facets, or hold the face along the contact's normal or tangent.")
 
     # -- the tangential parameter --------------------------------------------------------
     @property

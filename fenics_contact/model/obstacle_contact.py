@@ -24,7 +24,7 @@ from mpi4py import MPI
 
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.contacts import Contact
-from fenics_contact.model.friction import FrictionSettings, tangent_basis
+from fenics_contact.model.friction import FrictionSettings, symmetric_frame
 from fenics_contact.model.obstacles import RigidObstacle
 
 
@@ -112,7 +112,7 @@ class ObstacleContact(Contact):
         parent = self.surface.parent_dofs(W)
         n_owned = self.Q.dofmap.index_map.size_local
         held = np.zeros((parent.size, self.gdim), dtype=bool)
-        for facets, axis in held_components(solid.prescribed):
+        for facets, axis, _ in held_components(solid.prescribed):
             held[np.isin(parent, fem.locate_dofs_topological(W, fdim, facets)), axis] = True
         X = self.Q.tabulate_dof_coordinates()[:n_owned, : self.gdim]
         normal = self.obstacle.normal_value(X)
@@ -159,13 +159,54 @@ class ObstacleContact(Contact):
         X = ufl.SpatialCoordinate(self.domain)
         x = X + self.solid.u
         x_prev = X + u_prev
-        tangents = tangent_basis(self.obstacle.normal_at(x), self.gdim)
+        tangents = symmetric_frame(self.obstacle.normal_at(x), self.gdim, self._held_axes())
         motion = self.obstacle.point - self.c_prev
 
         def closest(y: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
             return y - self.obstacle.gap(y) * self.obstacle.normal_at(y)
 
         return tangents, tangents.T * (closest(x) - closest(x_prev + motion))
+
+    def _held_axes(self) -> tuple[fem.Function, fem.Function] | None:
+        """The frame's data at nodes held along a tangent that Duff's basis misses (3D).
+
+        At a node held along an axis e_a in the obstacle's tangent plane (at
+        load 0) where neither of Duff's tangents is e_a, the frame becomes
+        (e_a, n x e_a) (:func:`~.friction.symmetric_frame`), so that the held
+        slip is one frame component, which :mod:`.friction_terms` treats.
+        Elsewhere, and where Duff's basis already has e_a (a symmetry plane
+        through the axis of a ball or a plane), the frame is Duff's. None when
+        no node needs it (collective): the forms are then unchanged. A node
+        held along the normal keeps no friction (its gap is data:
+        :meth:`_held_normal_mask`); one held obliquely is refused when the
+        friction terms are built.
+        """
+        from fenics_contact.model.friction import held_components, tangent_basis_value
+
+        if self.gdim != 3:
+            return None  # one tangent: a held axis across the normal is that tangent
+        V = self.solid.V
+        fdim = V.mesh.topology.dim - 1
+        X = V.tabulate_dof_coordinates()
+        keep, axis = fem.Function(V, name="frame_keep"), fem.Function(V, name="frame_axis")
+        keep.x.array[:] = 1.0
+        e = axis.x.array.reshape(-1, 3)
+        for facets, a, _ in held_components(self.solid.prescribed):
+            blocks = fem.locate_dofs_topological(V, fdim, facets)
+            normal = self.obstacle.normal_value(X[blocks])
+            across = np.abs(normal[:, a]) < 1e-8
+            duff = np.max(np.abs(tangent_basis_value(normal)[:, a, :]), axis=1) >= 1.0 - 1e-8
+            pick = blocks[across & ~duff & ~np.any(e[blocks] != 0.0, axis=1)]
+            e[pick, a] = 1.0
+        if not self.comm.allreduce(int(np.count_nonzero(e)), op=MPI.SUM):
+            return None
+        axis.x.scatter_forward()
+        return keep, axis
+
+    def reference_normals(self) -> np.ndarray:
+        """The obstacle's unit normal at each owned multiplier node, load 0, shape (n, gdim)."""
+        n = self.Q.dofmap.index_map.size_local
+        return self.obstacle.normal_value(self.Q.tabulate_dof_coordinates()[:n, : self.gdim])
 
     def commit_frame(self) -> None:
         """c_prev <- c."""

@@ -375,12 +375,23 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
     contacts += [obstacle_contact(scene, body, entry, bodies) for entry in scene.obstacles]
     solid = _solid(scene, body.domain, bodies, body.cell_tags, prescribed=prescribed,
                    tractions=tractions)
-    problem = ContactProblem(solid, contacts)
+    problem = _problem(scene, solid, contacts)
     check_obstacles_face_their_facets(scene, problem)
     check_bodies_held(scene, problem, body.cell_tags, bodies, prescribed)
     check_initial_overlap(scene, problem)
     warn_initial_penetration(scene, problem)
     return problem
+
+
+def _problem(scene: Scene, solid: Solid, contacts: list) -> ContactProblem:
+    """The scene's :class:`ContactProblem`, its refusals as scene errors.
+
+    (A support that holds a frictional contact's node obliquely to its normal.)
+    """
+    try:
+        return ContactProblem(solid, contacts)
+    except ValueError as exc:
+        raise SceneError(f"{scene.path.name}: {exc}") from None
 
 
 def _solid(scene: Scene, *args, **kwargs) -> Solid:
@@ -412,7 +423,7 @@ def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProbl
                    [Body("body", None, material(scene.law, scene.E, scene.nu))],
                    prescribed=prescribed, tractions=tractions)
     contacts = [obstacle_contact(scene, body, entry) for entry in scene.obstacles]
-    problem = ContactProblem(solid, contacts)
+    problem = _problem(scene, solid, contacts)
     check_obstacles_face_their_facets(scene, problem)
     check_rigid_motions(scene, problem, free, prescribed)
     warn_initial_penetration(scene, problem)
