@@ -37,11 +37,14 @@ except ImportError:  # DOLFINx installed otherwise (official images)
 
 from fenics_contact import form_compiler
 from fenics_contact.model.body import Body, Solid
-from fenics_contact.model.compositions import one_body_problem
+from fenics_contact.model.compositions import one_body_problem, two_body_problem
 from fenics_contact.model.contact import ContactSettings
+from fenics_contact.model.friction import FrictionSettings
 from fenics_contact.model.materials import material
+from fenics_contact.model.mortar import MortarContact
 from fenics_contact.model.obstacle_contact import ObstacleContact
 from fenics_contact.model.obstacles import RigidBall, RigidPlane
+from fenics_contact.model.pairs import NodeToSegmentContact
 from fenics_contact.model.problem import (
     ContactProblem,
     PrescribedDisplacement,
@@ -64,7 +67,10 @@ __all__ = [
     "Body",
     "ContactProblem",
     "ContactSettings",
+    "FrictionSettings",
     "LinearSolverSettings",
+    "MortarContact",
+    "NodeToSegmentContact",
     "ObstacleContact",
     "PrescribedDisplacement",
     "RigidBall",
@@ -86,4 +92,5 @@ __all__ = [
     "scene_from_data",
     "scene_strategy",
     "solve_load_path",
+    "two_body_problem",
 ]

@@ -97,3 +97,15 @@ def test_a_free_component_is_spelt_as_in_scenes_too():
     assert PrescribedDisplacement(facets, [" Free", 0.0, None]).at(0.5) == (None, 0.0, None)
     with pytest.raises(ValueError, match=r"'fixed' is neither a number nor free"):
         PrescribedDisplacement(facets, ("fixed", 0.0))
+
+
+def test_a_body_tag_without_cell_tags_and_a_facet_mask_are_named():
+    """Both ran before and failed late: a tagged body with no cell tags integrated no cell
+    (every step "diverged"); a boolean mask was read as the facets 0 and 1."""
+    domain = mesh.create_unit_square(MPI.COMM_WORLD, 2, 2)
+    law = material("linear", E, NU)
+    with pytest.raises(ValueError, match=r"Body 'b' has cell tag 3, but no cell tags were given"):
+        Solid(domain, [Body("b", 3, law)])
+    plane = RigidPlane(domain, [0.0, 0.0], [0.0, 1.0])
+    with pytest.raises(TypeError, match=r"facets must be facet indices.*np.flatnonzero\(mask\)"):
+        ObstacleContact(plane, [True, False], ContactSettings())

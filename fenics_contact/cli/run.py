@@ -154,10 +154,18 @@ def _solve(
             f"{_count(s['load_steps'], 'step')}, {s['wall_s']:.1f} s; contact force "
             f"{path.steps[-1].contact_force:.6g}, max penetration "
             f"{_penetration(scene, outcome.problem, path.steps[-1].max_penetration)}"
-            f"\nWrote {out}/solution.xdmf, summary.json"
-            + ("" if args.no_pictures or not scene.pictures else ", deformed.png, residuals.png")
+            f"\nWrote {out}/{', '.join(_written(out))}"
         )
     return 0
+
+
+def _written(out: Path) -> list[str]:
+    """The run's files in ``out`` (an earlier run's summary and pictures were removed)."""
+    from fenics_contact.output.paraview import SCRIPT
+    from fenics_contact.runner import RUN_FILES
+
+    names = ["solution.xdmf", *RUN_FILES, SCRIPT]
+    return [name for name in names if (out / name).is_file()]
 
 
 def _count(n: int, noun: str) -> str:

@@ -148,6 +148,13 @@ def _check_bodies(domain: mesh.Mesh, cell_tags: mesh.MeshTags | None,
                 f"{len(bodies)} bodies need cell tags to tell them apart; give the mesh's "
                 "cell tags."
             )
+        if bodies[0].tag is not None:
+            raise ValueError(
+                f"Body {bodies[0].name!r} has cell tag {bodies[0].tag}, but no cell tags were "
+                "given: its energy would hold no cell. Give the mesh's cell tags "
+                "(Solid(..., cell_tags=...)), or tag=None for the one body that is the whole "
+                "mesh."
+            )
         return
     tags = [b.tag for b in bodies]
     if len(set(tags)) != len(tags):

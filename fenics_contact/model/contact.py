@@ -78,13 +78,17 @@ class ContactSettings:
     """How contact is regularised and integrated.
 
     Attributes:
-        r: penalty/augmentation parameter. Relative to E/h (h the mean contact
-            facet size) when ``relative`` is true, absolute (stress/length)
-            otherwise, as in the paper's tables (E = 210).
+        r: penalty/augmentation parameter, 1 by default. Relative to E/h (E
+            Young's modulus, h the mean contact facet size) when ``relative``
+            is true (the default), absolute (stress/length) otherwise, as the
+            paper's tables give it.
         relative: see ``r``.
-        quadrature: 'nodal' puts the quadrature points at the facet vertices
-            (the paper's node-on-facet, lumped multiplier mass, exact nodal
-            complementarity); 'gauss' integrates the term exactly-ish.
+        quadrature: 'nodal' (default) puts the quadrature points at the facet
+            vertices (the paper's node-on-facet, lumped multiplier mass, the
+            complementarity exact at each node, an answer independent of r);
+            'gauss' integrates the contact term with a degree-4 Gauss rule on
+            each facet (an integral constraint whose answer depends a little
+            on r; needed with quadratic displacements).
     """
 
     r: float = 1.0

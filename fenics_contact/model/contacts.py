@@ -61,7 +61,13 @@ class Contact:
         friction: FrictionSettings | None = None,
         name: str = "contact",
     ) -> None:
-        self.facets = np.unique(np.asarray(facets, dtype=np.int32))
+        given = np.asarray(facets)
+        if given.size and (given.dtype == bool or not np.issubdtype(given.dtype, np.integer)):
+            raise TypeError(
+                f"Contact {name!r}: facets must be facet indices (integers, e.g. "
+                f"tags.find(3) or mesh.locate_entities_boundary(...)), got {given.dtype} "
+                f"values{' (a mask: use np.flatnonzero(mask))' if given.dtype == bool else ''}.")
+        self.facets = np.unique(given.astype(np.int32))
         self.settings = settings
         self.friction_settings = friction
         self.friction: CoulombFriction | None = None

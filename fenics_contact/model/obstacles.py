@@ -51,9 +51,11 @@ class RigidObstacle:
 
 
 class RigidPlane(RigidObstacle):
-    """Half-space below a plane through ``point`` with outward unit ``normal``.
+    """Half-space below a plane through ``point`` with outward ``normal``.
 
     The body must stay on the side the normal points to: g = (x - x0) . n.
+    ``normal`` need not be of unit length: it is normalised (length units for
+    ``point``).
     """
 
     def __init__(
