@@ -61,3 +61,20 @@ def test_node_to_segment_is_told_to_strike_with_the_finer_surface():
     assert len(advice) == 1 and "ratio 1.3" in advice[0]  # the target's arc is 1.37 h
     scene, problem = _solved("two_cylinders_node_to_segment.toml", False, h_contact=0.02)
     assert advise_striker(scene, problem) == []
+
+
+
+def test_the_rim_of_a_striker_in_contact_is_seen_and_symmetry_cuts_are_no_rim():
+    """No swap is advised for a 3D mortar pair whose striker touches up to its rim (swapped,
+    the coarser surface would strike past the finer one's rim: a frictional block dragged
+    on a larger block did not survive it). The 3D patch test touches up to the rim; the
+    quarter sphere's block face, cut by two symmetry planes through the contact, does not."""
+    from fenics_contact.scene.striker_advice import rim_in_contact
+
+    _, problem = _solved("block_on_block_3d.toml", False)
+    contact = problem.contacts[0]
+    assert rim_in_contact(problem, contact, touching_sizes(problem, contact).striker)
+    _, problem = _solved("sphere_on_block_3d.toml", True, h_sphere=0.04, h_block=0.03,
+                         fine_radius=0.25)
+    contact = problem.contacts[0]
+    assert not rim_in_contact(problem, contact, touching_sizes(problem, contact).striker)

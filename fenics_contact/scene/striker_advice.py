@@ -18,6 +18,8 @@ import numpy as np
 from dolfinx import mesh
 from scipy.spatial import cKDTree
 
+from mpi4py import MPI
+
 from fenics_contact.model.mortar import MortarContact
 from fenics_contact.model.pairs import NodeToSegmentContact
 from fenics_contact.model.segments import node_blocks
@@ -98,12 +100,66 @@ def touching_sizes(problem: ContactProblem, contact) -> TouchingSizes | None:
     return TouchingSizes(float(striker.mean()), float(target.mean()), striker.size, target.size)
 
 
+def rim_in_contact(problem: ContactProblem, contact, size: float) -> bool:
+    """Whether the striker surface's rim lies within 1.5 ``size`` of a node in contact.
+
+    The rim: the sides of the striker's facets that no other striker facet
+    shares (reference positions). Swapping such a pair would let the new
+    striker overhang its target where they touch. Collective.
+    """
+    from fenics_contact.model.target_surface import free_sides
+
+    domain, comm = problem.domain, problem.comm
+    gdim, fdim = domain.geometry.dim, domain.topology.dim - 1
+    state = contact.contact_state()
+    pressed = np.concatenate(comm.allgather(contact.nodal_coordinates()[state.active][:, :gdim]))
+    facets = np.asarray(contact.facets, np.int32)
+    facets = facets[facets < domain.topology.index_map(fdim).size_local]
+    nodes = (mesh.entities_to_geometry(domain, fdim, facets) if facets.size
+             else np.zeros((0, gdim), np.int32))
+    local = node_blocks(problem.V)[nodes].reshape(-1).astype(np.int32)
+    blocks = problem.V.dofmap.index_map.local_to_global(local).reshape(nodes.shape)
+    free = free_sides(blocks.astype(np.int64), comm)
+    X = domain.geometry.x[nodes][..., :gdim]
+    if gdim == 2:
+        sides = X[free][:, None, :]
+    else:
+        sides = np.concatenate([X[free[:, k]][:, [(k + 1) % 3, (k + 2) % 3]]
+                                for k in range(3)]) if X.size else np.zeros((0, 2, gdim))
+    # a side on a symmetry plane is no rim: the mirrored surface goes on
+    for where, axis in _plane_coordinates(problem):
+        sides = sides[~np.all(np.abs(sides[:, :, axis] - where) <= 1e-9, axis=1)]
+    rim = sides.reshape(-1, gdim)
+    near = False
+    if rim.shape[0] and pressed.shape[0]:
+        distance, _ = cKDTree(pressed).query(rim)
+        near = bool(np.any(distance <= 1.5 * size))
+    return bool(comm.allreduce(near, op=MPI.LOR))
+
+
+def _plane_coordinates(problem: ContactProblem) -> list[tuple[float, int]]:
+    """(coordinate, axis) of each symmetry plane of the problem (collective)."""
+    from fenics_contact.model.friction import symmetry_planes
+
+    domain = problem.domain
+    fdim = domain.topology.dim - 1
+    out = []
+    for facets, axis in symmetry_planes(domain, problem.solid.prescribed):
+        nodes = mesh.entities_to_geometry(domain, fdim, np.asarray(facets, np.int32))
+        mine = float(domain.geometry.x[nodes.reshape(-1), axis][0]) if nodes.size else np.inf
+        out.append((problem.comm.allreduce(mine, op=MPI.MIN), axis))
+    return out
+
+
 def advise_striker(scene: Scene, problem: ContactProblem) -> list[str]:
     """Warn, per two-body pair, when the other surface should strike; return the advice given.
 
     Mortar in 3D: the striker's facets where it touches finer than RATIO times
     the target's (in 2D the coarser striker smooths the inside of the zone but
-    resolves its edge with fewer nodes: no advice). Node-to-segment: coarser
+    resolves its edge with fewer nodes: no advice), unless the striker's rim
+    is in contact: swapped, the coarser surface would overhang the finer
+    one's rim, which a frictional block dragged on a larger block did not
+    survive (it cycled, where the given striker converges). Node-to-segment: coarser
     than the target's by as much. Self-contact pairs have one surface and get
     none. Collective.
     """
@@ -120,6 +176,8 @@ def advise_striker(scene: Scene, problem: ContactProblem) -> list[str]:
             continue
         ratio = sizes.striker / sizes.target
         if mortar and problem.domain.geometry.dim == 3 and ratio < RATIO:
+            if rim_in_contact(problem, contact, sizes.striker):
+                continue  # swapped, the striker would overhang its target's rim there
             why = ("a mortar pair's nodal pressures are smoother with the coarser surface "
                    "striking (about half the scatter)")
         elif not mortar and ratio > 1.0 / RATIO:
