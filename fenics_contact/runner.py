@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import sys
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -63,8 +64,12 @@ def contact_settings(problem: ContactProblem) -> dict[str, dict]:
     return used
 
 
-def _summary(scene: Scene, record: RunRecord, used: dict[str, dict] | None = None) -> dict:
+def _summary(scene: Scene, record: RunRecord, used: dict[str, dict] | None = None,
+             notes: Sequence[str] = ()) -> dict:
     """summary.json: the scene's identity and settings, then the run record.
+
+    ``notes``: the scene's warnings so far (built, then checked after the run),
+    as printed, under ``warnings``.
 
     ``bodies``, ``pairs`` (declared, then found by [pairing]) and
     ``obstacles`` hold each one's own settings; ``used``
@@ -134,6 +139,7 @@ def _summary(scene: Scene, record: RunRecord, used: dict[str, dict] | None = Non
             {"name": b.name, "tag": b.tag, "law": b.law, "E": b.E, "nu": b.nu}
             for b in scene.bodies
         ] or [{"name": "body", "tag": None, "law": scene.law, "E": scene.E, "nu": scene.nu}],
+        "warnings": list(notes),
     }
 
 
@@ -151,9 +157,9 @@ def _contact_steps(record: RunRecord, name: str, frictional: bool) -> list[dict]
 
 
 def _write_summary(comm: MPI.Comm, out: Path, scene: Scene, record: RunRecord,
-                   used: dict[str, dict]) -> dict:
+                   used: dict[str, dict], notes: Sequence[str] = ()) -> dict:
     """Write summary.json (rank 0); a failed write stops every process alike."""
-    summary = _summary(scene, record, used)
+    summary = _summary(scene, record, used, notes)
     failure = None
     if comm.rank == 0:
         try:
@@ -234,6 +240,23 @@ def _warn_loose_tolerance(scene: Scene, problem: ContactProblem) -> None:
         ), stacklevel=2)
 
 
+@contextmanager
+def _kept(notes: list[str]):
+    """Keep the text of every SceneWarning issued inside in ``notes``, and issue it as usual."""
+    from fenics_contact.scene.checks import SceneWarning
+
+    caught: list = []
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", SceneWarning)
+            yield
+    finally:  # also when the scene is refused: its warnings came first
+        for w in caught:
+            if issubclass(w.category, SceneWarning):
+                notes.append(str(w.message))
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+
+
 def run_scene(
     scene: Scene,
     out: Path | str,
@@ -258,9 +281,11 @@ def run_scene(
     out = Path(out)
     run_identity = identity(scene, comm.size)
     marker = read_latest(out / "checkpoint", run_identity) if resume else None  # before building
-    problem = build_problem(scene, comm)
+    notes: list[str] = []
+    with _kept(notes):
+        problem = build_problem(scene, comm)
+        _warn_loose_tolerance(scene, problem)
     used = contact_settings(problem)
-    _warn_loose_tolerance(scene, problem)
     strategy = scene_strategy(scene, problem, on_residual)
     saved = restore(out / "checkpoint", problem, marker) if marker is not None else None
     if isinstance(strategy, Extrapolated) and saved is not None and saved.history:
@@ -287,7 +312,7 @@ def run_scene(
         gaps = strategy.gap_history if isinstance(strategy, ActiveSetPredicted) else []
         checkpoint.write(step.step, [s.to_dict() for s in record.steps], history,
                          files=writer.written, gaps=gaps)
-        _write_summary(comm, out, scene, record, used)
+        _write_summary(comm, out, scene, record, used, notes)
         if on_step is not None:
             on_step(step)
 
@@ -302,7 +327,7 @@ def run_scene(
         record.message = (f"{stop} after {done} finished load step{'s' if done != 1 else ''}; "
                           "continue with --resume")
         if comm.rank == 0:
-            write_json(out / "summary.json", _summary(scene, record, used))
+            write_json(out / "summary.json", _summary(scene, record, used, notes))
         raise
     finally:
         writer.close()
@@ -310,11 +335,12 @@ def run_scene(
         # the failed step's record holds the state the run stopped in (restored)
         path.steps[-1].reactions = problem.support_reactions()
         path.steps[-1].reaction_total = problem.support_total()
-    summary = _write_summary(comm, out, scene, path, used)
-    warn_untagged_penetration(scene, problem)
-    warn_body_overlap(scene, problem)
-    advise_striker(scene, problem)
-    warn_pressure_scatter(scene, problem)
+    with _kept(notes):
+        warn_untagged_penetration(scene, problem)
+        warn_body_overlap(scene, problem)
+        advise_striker(scene, problem)
+        warn_pressure_scatter(scene, problem)
+    summary = _write_summary(comm, out, scene, path, used, notes)
     if not finished_steps(out / "solution.xdmf"):  # no step on disk: nothing to open
         if comm.rank == 0:
             (out / SCRIPT).unlink(missing_ok=True)

@@ -35,6 +35,7 @@ def test_the_non_matching_patch_test_on_node_to_segment_is_named(tmp_path):
     median = float(np.median(scatter)) / mean
     assert median > 1.5 * SCATTER  # 0.16 measured
     assert f"by {median:.0%} of their mean" in said[0]
+    assert said[0] in outcome.summary["warnings"]  # kept in summary.json too
 
 
 def test_a_smooth_node_to_segment_profile_is_not(tmp_path):

@@ -440,6 +440,10 @@ def test_a_run_that_fails_after_starting_inside_an_obstacle_says_so_first(tmp_pa
     assert code == 1
     assert ("To try: first the start: the body starts 0.6 inside the obstacle (2.4 h, the "
             "warning at the start)") in capsys.readouterr().err
+    import json
+
+    kept = json.loads((tmp_path / "out" / "summary.json").read_text())["warnings"]
+    assert any("starts 0.6 inside the obstacle" in w for w in kept)  # in summary.json too
 
 
 @pytest.mark.parametrize("change, fix", [
