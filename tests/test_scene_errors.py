@@ -687,3 +687,21 @@ def test_a_pair_tag_mistake_names_the_pair(tmp_path):
     with pytest.raises(SceneError, match=r"\[\[pair\]\] 'on-right' striker tag = "
                                          r"'bridge_under_rihgt' is not a facet tag"):
         build_problem(load_scene(tmp_path / "bridge.toml"))
+
+
+def test_load_steps_that_pass_over_a_knot_of_a_frictional_path_are_warned(tmp_path):
+    """Press to t = 0.4, then drag: one step would press and drag along a diagonal."""
+    from fenics_contact.scene.build import SceneWarning
+
+    scene = base()
+    scene["contact"]["mu"] = 0.3
+    scene["dirichlet"][0] = {"tag": "top", "path": [[0.0, 0.0, 0.0], [0.4, 0.0, -0.05],
+                                                    [1.0, 0.02, -0.05]]}
+    scene["solver"]["steps"] = 1
+    with pytest.warns(SceneWarning, match=r"the 1 load steps \(t = k/1\) pass over the path "
+                      r"knot\(s\) t = 0.4: .* \(e.g. 5\)"):
+        _build(write(tmp_path, scene))
+    scene["solver"]["steps"] = 10  # lands on 0.4
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", SceneWarning)
+        _build(write(tmp_path, scene))

@@ -44,6 +44,7 @@ from fenics_contact.scene.checks import (
     facet_owners,
     held_by_closed_contacts,
     warn_locking,
+    warn_skipped_knots,
 )
 from fenics_contact.scene.meshing import gmsh_session, mesh_on_rank, open_geo, overlapping_groups
 from fenics_contact.scene.pairing import pairing_contacts
@@ -407,6 +408,7 @@ def _solid(scene: Scene, *args, **kwargs) -> Solid:
 
 def build_problem(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> ContactProblem:
     """Mesh, material, conditions, obstacle and contact surface of a scene."""
+    warn_skipped_knots(scene)
     body = build_mesh(scene, comm)
     check_cells(scene, body.domain)
     if scene.two_body:

@@ -176,6 +176,38 @@ def check_pair_surfaces(
 LOCKING_NU = 0.49
 
 
+def warn_skipped_knots(scene: Scene) -> list[float]:
+    """Warn when a frictional scene's load steps pass over a knot of a path or schedule.
+
+    The steps visit t = k / steps (and the points a cut-back adds); between
+    them every prescribed motion moves straight. A knot between two steps is
+    cut off: press-then-drag becomes a diagonal in one step, and with
+    friction the answer depends on the path. Returns the knots passed over.
+    """
+    if not scene.frictional:
+        return []
+    n = scene.solver.steps
+    knots = {float(k[0]) for d in scene.dirichlet for k in d.path}
+    knots |= {float(k[0]) for o in scene.obstacles for k in o.obstacle.schedule}
+    missed = sorted(t for t in knots if 0.0 < t < 1.0 and abs(t * n - round(t * n)) > 1e-9)
+    if missed:
+        warnings.warn(SceneWarning(
+            f"{scene.path.name}: the {n} load steps (t = k/{n}) pass over the path knot(s) "
+            f"t = {', '.join(f'{t:g}' for t in missed)}: between steps each motion moves "
+            "straight, so a turn of the path there is cut off, and with friction the answer "
+            "depends on the path. Choose [solver] steps so that k/steps lands on every knot "
+            f"(e.g. {_landing_steps(missed, n)})."), stacklevel=2)
+    return missed
+
+
+def _landing_steps(knots: list[float], at_least: int) -> int:
+    """The fewest steps >= ``at_least`` whose grid k/steps holds every knot (or a guess)."""
+    for steps in range(at_least, 100 * at_least + 1):
+        if all(abs(t * steps - round(t * steps)) <= 1e-9 for t in knots):
+            return steps
+    return 10 * at_least
+
+
 def warn_locking(scene: Scene, nu: float, where: str) -> None:
     """Warn that P1 displacements lock near incompressibility (pressures far too high)."""
     if LOCKING_NU < nu < 0.5:  # (0.5 and above are refused with the reason)
