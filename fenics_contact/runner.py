@@ -9,6 +9,8 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from mpi4py import MPI
 
 from fenics_contact.model.problem import ContactProblem
@@ -130,8 +132,9 @@ def _summary(scene: Scene, record: RunRecord, used: dict[str, dict] | None = Non
                 "name": o.name, "type": o.obstacle.type, "tag": o.contact.tag,
                 "r": o.contact.r, "relative": o.contact.relative, **built(o.name),
                 "mu": o.contact.mu, "tangential_r_max": o.contact.tangential_r_max,
-                "quadrature": o.contact.quadrature,
-                "steps": _contact_steps(record, o.name, o.contact.mu is not None),
+                "quadrature": o.contact.quadrature, **_shape(o.obstacle),
+                "steps": [{**s, "point": _placed(o.obstacle, s["load_factor"])} for s in
+                          _contact_steps(record, o.name, o.contact.mu is not None)],
             }
             for o in scene.obstacles
         ],
@@ -144,6 +147,26 @@ def _summary(scene: Scene, record: RunRecord, used: dict[str, dict] | None = Non
 
 
 _FRICTION_KEYS = ("tangential_force", "stick_count", "slip_count")
+
+
+def _shape(spec) -> dict:
+    """An obstacle's geometry in summary.json (length).
+
+    Its point (plane) or centre (ball) at load 0, and its normal, or its
+    radius and side.
+    """
+    if spec.type == "plane":
+        return {"point": list(spec.point), "normal": list(spec.normal)}
+    return {"point": list(spec.point), "radius": spec.radius, "inside": spec.inside}
+
+
+def _placed(spec, t: float) -> list[float]:
+    """Where an obstacle's point (a ball's centre) is at load factor t (length)."""
+    from fenics_contact.model.obstacle_contact import obstacle_offset, obstacle_schedule
+
+    motion = np.zeros(len(spec.point)) if not spec.motion else np.asarray(spec.motion, float)
+    schedule = obstacle_schedule(spec.schedule or None, len(spec.point))
+    return (np.asarray(spec.point, float) + obstacle_offset(motion, schedule, t)).tolist()
 
 
 def _contact_steps(record: RunRecord, name: str, frictional: bool) -> list[dict]:

@@ -147,3 +147,25 @@ def test_a_damaged_step_file_is_named_and_a_run_without_pressure_draws_displacem
     index.write_text(text[:start] + text[text.index("</Attribute>", start) + 12:])
     png = render_step(copy, step=9)
     assert png.name == "render_step_0009_displacement.png" and png.is_file()
+
+
+
+def test_render_draws_the_obstacle_where_the_step_put_it(tmp_path):
+    """block_slide_friction: the plane rises 0.01 by t = 0.4, then slides 0.02 (its
+    schedule); summary.json gives its point at every step and render draws it there."""
+    import json
+
+    from fenics_contact.output.render import obstacle_outlines
+
+    out = tmp_path / "slide"
+    assert run_scene(load_scene(SCENES / "block_slide_friction.toml"), out, pictures=False,
+                     comm=MPI.COMM_SELF).path.converged
+    (plane,) = json.loads((out / "summary.json").read_text())["obstacles"]
+    assert (plane["type"], plane["normal"]) == ("plane", [0.0, 1.0])
+    points = {s["step"]: s["point"] for s in plane["steps"]}
+    np.testing.assert_allclose(points[8], [0.0, 0.01], atol=1e-14)  # t = 0.4
+    np.testing.assert_allclose(points[20], [0.02, 0.01], atol=1e-14)
+    bounds = np.array([[0.0, 0.0, 0.0], [1.0, 0.5, 0.0]])
+    (line,) = obstacle_outlines(out, 8, bounds)
+    np.testing.assert_allclose(np.asarray(line.points)[:, 1], 0.01, atol=1e-12)
+    assert obstacle_outlines(tmp_path, 8, bounds) == []  # no run there: nothing drawn

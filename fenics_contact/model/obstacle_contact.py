@@ -50,6 +50,19 @@ def obstacle_schedule(
     return times, table[:, 1:]
 
 
+def obstacle_offset(motion: np.ndarray, schedule: tuple[np.ndarray, np.ndarray] | None,
+                    t: float) -> np.ndarray:
+    """An obstacle's displacement at load factor t (length).
+
+    ``t * motion``, or the validated ``schedule`` (:func:`obstacle_schedule`)
+    interpolated.
+    """
+    if schedule is None:
+        return t * np.asarray(motion, float)
+    times, offsets = schedule
+    return np.array([np.interp(t, times, offsets[:, i]) for i in range(offsets.shape[1])])
+
+
 class ObstacleContact(Contact):
     """Candidate facets of the solid against a rigid obstacle.
 
@@ -129,10 +142,7 @@ class ObstacleContact(Contact):
 
     def offset(self, t: float) -> np.ndarray:
         """Obstacle displacement at load factor t: t * motion, or the schedule interpolated."""
-        if self._schedule is None:
-            return t * self._motion
-        times, offsets = self._schedule
-        return np.array([np.interp(t, times, offsets[:, i]) for i in range(offsets.shape[1])])
+        return obstacle_offset(self._motion, self._schedule, t)
 
     def gap_origin(self) -> np.ndarray:
         """The obstacle's reference point (length): the gap is measured from it."""

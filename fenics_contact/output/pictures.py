@@ -32,15 +32,32 @@ from fenics_contact.output.io import ContactsToBody
 
 
 def _obstacle_mesh(problem: ContactProblem, obstacle: RigidObstacle, bounds: np.ndarray):
+    if isinstance(obstacle, RigidPlane):
+        return obstacle_outline("plane", obstacle.point.value, bounds,
+                                normal=obstacle.normal.value)
+    assert isinstance(obstacle, RigidBall)
+    return obstacle_outline("ball", obstacle.point.value, bounds,
+                            radius=float(obstacle.radius.value))
+
+
+def obstacle_outline(kind: str, point, bounds: np.ndarray, *, normal=None,
+                     radius: float | None = None):
+    """A rigid obstacle to draw beside bodies within ``bounds`` (2 x 3, length).
+
+    ``kind`` 'plane' (through ``point``, unit ``normal``: a segment in 2D, a
+    square in 3D, 1.5 times the bodies' span) or 'ball' (centre ``point``,
+    ``radius``: a circle in 2D, a sphere in 3D). The dimension is ``point``'s.
+    """
     import pyvista
 
-    gdim = problem.domain.geometry.dim
+    gdim = len(point)
     centre = np.zeros(3)
-    centre[:gdim] = obstacle.point.value
+    centre[:gdim] = point
     span = float(np.max(bounds[1] - bounds[0]))
-    if isinstance(obstacle, RigidPlane):
-        normal = np.zeros(3)
-        normal[:gdim] = obstacle.normal.value
+    if kind == "plane":
+        normal_3 = np.zeros(3)
+        normal_3[:gdim] = normal
+        normal = normal_3 / np.linalg.norm(normal_3)
         mid = 0.5 * (bounds[0] + bounds[1])
         # the point of the plane nearest the body's centre
         foot = mid - np.dot(mid - centre, normal) * normal
@@ -48,8 +65,7 @@ def _obstacle_mesh(problem: ContactProblem, obstacle: RigidObstacle, bounds: np.
             tangent = np.array([normal[1], -normal[0], 0.0])
             return pyvista.Line(foot - 0.75 * span * tangent, foot + 0.75 * span * tangent)
         return pyvista.Plane(center=foot, direction=normal, i_size=1.5 * span, j_size=1.5 * span)
-    assert isinstance(obstacle, RigidBall)
-    radius = float(obstacle.radius.value)
+    radius = float(radius)  # type: ignore[arg-type]
     if gdim == 2:
         angles = np.linspace(0.0, 2.0 * np.pi, 721)
         ring = np.column_stack([np.cos(angles), np.sin(angles), 0.0 * angles]) * radius

@@ -68,6 +68,27 @@ def body_names(out: Path) -> list[str]:
         return []
 
 
+def obstacle_outlines(out: Path, step: int, bounds: np.ndarray) -> list:
+    """The run's rigid obstacles placed as at load step ``step`` (PyVista meshes).
+
+    From summary.json (each obstacle's shape and its point at every finished
+    step); empty when it holds none, or when the run is older than these
+    records.
+    """
+    from fenics_contact.output.pictures import obstacle_outline
+
+    try:
+        obstacles = json.loads((out / "summary.json").read_text()).get("obstacles", [])
+        shapes = []
+        for o in obstacles:
+            placed = next(s["point"] for s in o["steps"] if s["step"] == step)
+            shapes.append(obstacle_outline(o["type"], placed, bounds, normal=o.get("normal"),
+                                           radius=o.get("radius")))
+        return shapes
+    except (OSError, ValueError, TypeError, KeyError, AttributeError, StopIteration):
+        return []
+
+
 def _step_file(out: Path, step: int | None) -> tuple[Path, int]:
     """The step file of ``step`` (None: the last finished one), or ValueError naming the steps."""
     index = out / "solution.xdmf"
@@ -173,8 +194,10 @@ def draw_step(
     style: dict[str, object] = {
         "scalars": label, "cmap": _CMAPS.get(field, "viridis"),
         "scalar_bar_args": {"title": bar}}
+    bounds = np.array(grid.bounds).reshape(3, 2).T
+    outlines = obstacle_outlines(out, chosen, bounds)
     if flat:
-        picture, plotter = _draw_plane(grid, style, label, bar, window)
+        picture, plotter = _draw_plane(grid, style, label, bar, window, outlines)
     else:
         if "contact_pressure" in grid.point_data:
             grid.point_data[PRESSURE] = np.asarray(grid.point_data["contact_pressure"])
@@ -186,11 +209,19 @@ def draw_step(
                                     "position_y": 0.2, "height": 0.6}
         if field == "stick_slip":
             style = stick_slip_style()
+        def context(plotter, near_bounds: np.ndarray) -> None:
+            grow = 0.15 * (near_bounds[1] - near_bounds[0])
+            box = np.concatenate([near_bounds[0] - grow, near_bounds[1] + grow])[
+                [0, 3, 1, 4, 2, 5]]
+            for shape in outlines:  # only its part near the bodies
+                plotter.add_mesh(shape.clip_box(tuple(box), invert=False), color="#555555",
+                                 opacity=0.3)
+
         picture, plotter = draw_solid(
             grid, style, name=label, nodal=field in ("stick_slip", "active"),
-            size=window[1], body_names=body_names(out))
+            size=window[1], body_names=body_names(out), context=context)
         plotter.subplot(0, 0)
-    plotter.add_text(f"{out.name}: step {chosen}, {label}", font_size=12)
+    plotter.add_text(f"{_run_name(out)}: step {chosen}, {label}", font_size=12)
     target = path or out / f"render_step_{chosen:04d}_{field}.png"
     target.parent.mkdir(parents=True, exist_ok=True)
     plotter.screenshot(str(target))
@@ -198,7 +229,16 @@ def draw_step(
     return target, picture
 
 
-def _draw_plane(grid, style: dict, label: str, bar: str, window: tuple[int, int]):
+def _run_name(out: Path) -> str:
+    """The scene's name from the run's summary.json, else the folder's name."""
+    try:
+        return str(json.loads((out / "summary.json").read_text())["scene"])
+    except (OSError, ValueError, TypeError, KeyError):
+        return out.name
+
+
+def _draw_plane(grid, style: dict, label: str, bar: str, window: tuple[int, int],
+                outlines: list = ()):
     """2D: the whole body, and beside it a window on each small contact zone (as deformed.png).
 
     The zones are those of the step's contact pressure (any field is drawn
@@ -232,9 +272,11 @@ def _draw_plane(grid, style: dict, label: str, bar: str, window: tuple[int, int]
             plotter.add_mesh(pressed.copy(), scalars=PRESSURE, cmap=style["cmap"],
                              clim=[0.0, float(np.max(grid.point_data[PRESSURE]))],
                              line_width=8 if column else 5, show_scalar_bar=False)
+        for shape in outlines:  # the rigid obstacles, as in deformed.png
+            plotter.add_mesh(shape.copy(), color="#555555", line_width=3)
         plotter.view_xy()
         plotter.camera.parallel_projection = True
-        if zooms:
+        if zooms or outlines:  # the bodies framed, not the obstacles' lines
             _frame(plotter, frame, aspect=width / (1 + len(zooms)) / window[1])
             plotter.add_text(title, position="lower_left", font_size=10)
         picture.panels.append(title)
