@@ -45,3 +45,35 @@ def test_the_supports_balance_when_a_held_node_is_in_contact(tmp_path_factory):
     depth = float(re.search(r"lies ([0-9.e-]+) \(", behind[0]).group(1))
     assert depth == pytest.approx(7.27e-4, rel=0.02)
     assert "striker = target: every node is held" in behind[0]
+
+
+def test_a_failed_step_records_the_converged_state_it_stops_in(tmp_path):
+    """A step that fails after a cut-back converged: its record (load factor, reactions)
+    is the converged sub-step's, at its own load, and the supports balance. Before, the
+    failed attempt's load stayed set and the reactions fell back to the strain energy's
+    forces (the held corner's contact left out)."""
+    from fenics_contact import build_problem, scene_strategy, solve_load_path
+    from fenics_contact.solvers.base import SolveResult
+    from fenics_contact.solvers.diagnostics import Status
+
+    scene = load_scene(ROOT / "scenes" / "u_strip.toml")
+    problem = build_problem(scene, MPI.COMM_SELF)
+    strategy = scene_strategy(scene, problem)
+    solve = strategy.solve
+
+    def failing_at_the_end() -> SolveResult:
+        result = solve()  # iterates: u and the solver's last residual move on
+        if problem.load_factor > 0.99:  # the last step (0.8 -> 1) stops at 0.975
+            return SolveResult(Status.CYCLING, result.iterations, 0, result.linear_solves,
+                               result.residuals)
+        return result
+
+    strategy.solve = failing_at_the_end
+    record = solve_load_path(strategy, scene.solver.steps, max_cutbacks=3)
+    failed = record.steps[-1]
+    assert (failed.status, failed.load_factor) == ("cycling", pytest.approx(0.975))
+    assert problem.load_factor == pytest.approx(0.975)
+    push = problem.support_reactions()["tip"]
+    assert abs(push[1]) > 1.0  # the corner in contact holds the push
+    total = problem.support_total()
+    assert max(abs(v) for v in total) < 1e-8 * abs(push[1])

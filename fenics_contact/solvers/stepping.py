@@ -269,6 +269,20 @@ def refusal(strategy: Strategy, result: SolveResult) -> str | None:
     return None if check is None else check()
 
 
+def _settle(strategy: Strategy, t: float) -> None:
+    """Put the problem at the state a failed step stops in: the last converged u, at its load.
+
+    The failed attempt left its load factor set and the solver's last
+    residual (whose Dirichlet rows are the supports' reactions) at the failed
+    iterate; the record and the reactions read at ``t`` must be those of the
+    restored, converged state.
+    """
+    strategy.problem.set_load(t)
+    kernel = getattr(strategy, "kernel", None)
+    if kernel is not None:
+        kernel.assemble_residual()
+
+
 def _failure_message(record: StepRecord, t_try: float, refused: str | None = None) -> str:
     if record.status == Status.INVERTED:
         x = ", ".join(f"{c:.4g}" for c in record.worst_cell)
@@ -384,6 +398,7 @@ def solve_load_path(
                 step.status = status.value
                 step.load_factor = t
                 step.message = _failure_message(step, t_try, refused)
+                _settle(strategy, t)
                 break
             increment /= 2
             step.cutbacks += 1
