@@ -231,7 +231,15 @@ def test_penalty_penetration_is_given_in_facet_sizes_with_a_note(tmp_path, capsy
     scene.write_text(text)  # GNRM: no penetration, no note
     assert main(["run", str(scene), "--out", str(tmp_path / "gnrm"), "--no-pictures"]) == 0
     line = next(x for x in capsys.readouterr().out.splitlines() if "max penetration" in x)
-    assert "penalty" not in line
+    assert "penalty" not in line and "warning" not in line
+
+
+def test_the_summary_line_counts_the_warnings(tmp_path, capsys):
+    """Warnings scroll by during a run; the last line says how many and where they are kept."""
+    scene = SCENES / "block_on_block_node_to_segment.toml"  # warns twice (its header says why)
+    assert main(["run", str(scene), "--out", str(tmp_path / "out"), "--no-pictures"]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if "max penetration" in x)
+    assert line.endswith("; 2 warnings above (kept in summary.json)")
 
 
 def test_a_log_gets_one_line_per_load_step(tmp_path, capsys):

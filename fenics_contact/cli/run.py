@@ -154,9 +154,17 @@ def _solve(
             f"{_count(s['load_steps'], 'step')}, {s['wall_s']:.1f} s; contact force "
             f"{path.steps[-1].contact_force:.6g}, max penetration "
             f"{_penetration(scene, outcome.problem, path.steps[-1].max_penetration)}"
+            f"{_warned(s.get('warnings', []))}"
             f"\nWrote {out}/{', '.join(_written(out))}"
         )
     return 0
+
+
+def _warned(notes: list[str]) -> str:
+    """'; 2 warnings above (kept in summary.json)' after a run that warned, else ''."""
+    if not notes:
+        return ""
+    return f"; {_count(len(notes), 'warning')} above (kept in summary.json)"
 
 
 def _written(out: Path) -> list[str]:
