@@ -78,3 +78,17 @@ def test_a_step_whose_residual_is_nan_from_the_start_says_so():
     assert "NaN or infinite at its first evaluation in every attempt" in message
     record.residuals = [[float("nan")], [3.0, float("nan")]]  # one attempt got going
     assert "NaN" not in _failure_message(record, 0.125)
+
+
+def test_a_step_whose_first_linear_solve_always_fails_says_so():
+    """Diverged with one finite residual per attempt: the first linear solve failed each
+    time (a user's 2D mortar slide stopped so, and the advice to cut steps did nothing)."""
+    from fenics_contact.solvers.stepping import StepRecord, _failure_message
+
+    record = StepRecord(step=10, load_factor=0.45, status=Status.DIVERGED, cutbacks=2,
+                        residuals=[[132.07], [0.21], [0.0999]])
+    message = _failure_message(record, 0.4531)
+    assert "in every attempt the linear solve of the first Newton step failed" in message
+    assert "smaller steps do not change" in message
+    record.residuals = [[132.07], [0.21, 0.01, 0.5]]  # one attempt took Newton steps
+    assert "linear solve" not in _failure_message(record, 0.4531)

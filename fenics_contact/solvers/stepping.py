@@ -298,6 +298,12 @@ def _failure_message(record: StepRecord, t_try: float, refused: str | None = Non
         message += ("; the residual was NaN or infinite at its first evaluation in every attempt "
                     "(no Newton step could be taken): a form gave a non-number at the step's "
                     "start state")
+    elif (record.status == Status.DIVERGED and firsts
+          and all(len(r) == 1 and math.isfinite(r[0]) for r in record.residuals)):
+        message += ("; in every attempt the linear solve of the first Newton step failed: "
+                    "the Jacobian is singular at the step's start state (a node with more "
+                    "contact conditions than free components, or a constraint with no "
+                    "derivative there), which smaller steps do not change")
     if refused:
         message += f"; the residual met its tolerance but the iterate was refused: {refused}"
     return message
