@@ -15,7 +15,8 @@ G_j = g~_j / A~_j, A~_j = int_{segments} N_j dA (the part of the support the
 target covers; A~_j = A_j = int N_j dA where the target covers the
 support), and Alart-Curnier holds on the pairs (lam_j, G_j) with the vertex
 rule, so the converged answer does not depend on r. A node whose support
-meets no target facet is open (G_j = h).
+meets no target facet is open: G_j = h + max(-lam_j / r, 0), which opens it
+at once whatever pressure it carried.
 
 The segment end points are the projections of the target facet ends onto
 the striker facet (clamped to it), min/max expressions of the current
@@ -340,7 +341,11 @@ class MortarContact(Contact):
         #: The gap of a node whose support meets no target facet (length; a Constant so
         #: that the compiled forms do not depend on the mesh).
         self.open_gap = fem.Constant(solid.domain, default_scalar_type(self.surface.h))
-        return self.mortar.nodal_gap(X, X + solid.u, self.open_gap)
+        # a node that loses its last segment while it still carries pressure (a stiff
+        # target's corner passing over it) must open at once: with a gap of h alone,
+        # lam + r h < 0 kept it active with a gap of no derivative, a zero Jacobian row
+        uncovered = self.open_gap + ufl.max_value(-self.lam / self.r, 0.0)
+        return self.mortar.nodal_gap(X, X + solid.u, uncovered)
 
     def may_close(self, gaps: np.ndarray) -> np.ndarray:
         """3D: only engaged nodes (G <= 1e-3 h) carry dG/du while open; 2D: every node."""
