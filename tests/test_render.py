@@ -169,3 +169,19 @@ def test_render_draws_the_obstacle_where_the_step_put_it(tmp_path):
     (line,) = obstacle_outlines(out, 8, bounds)
     np.testing.assert_allclose(np.asarray(line.points)[:, 1], 0.01, atol=1e-12)
     assert obstacle_outlines(tmp_path, 8, bounds) == []  # no run there: nothing drawn
+
+
+def test_2d_stick_slip_is_drawn_on_the_nodes_by_category(tmp_path):
+    """block_slide_friction at full sliding: every contact node red (slip), nothing smeared
+    over the cells (the map was a continuous colour field across the bottom row)."""
+    from matplotlib.image import imread
+
+    out = tmp_path / "slide"
+    assert run_scene(load_scene(SCENES / "block_slide_friction.toml"), out, pictures=False,
+                     comm=MPI.COMM_SELF).path.converged
+    png, picture = draw_step(out, field="stick_slip", path=tmp_path / "s.png")
+    image = imread(png)[..., :3]
+    red = np.all(np.abs(image - np.array([0xd6, 0x27, 0x28]) / 255.0) < 0.08, axis=2)
+    blue = np.all(np.abs(image - np.array([0x1f, 0x77, 0xb4]) / 255.0) < 0.08, axis=2)
+    # the slip nodes, and the bar's three swatches; no stick node at full sliding
+    assert red.sum() > blue.sum() > 0

@@ -197,7 +197,12 @@ def draw_step(
     bounds = np.array(grid.bounds).reshape(3, 2).T
     outlines = obstacle_outlines(out, chosen, bounds)
     if flat:
-        picture, plotter = _draw_plane(grid, style, label, bar, window, outlines)
+        nodal = field in ("stick_slip", "active")
+        if field == "stick_slip":
+            grid.point_data[STICK_SLIP] = values
+            style = {**stick_slip_style(), "scalar_bar_args": {"title": "stick/slip",
+                                                              "n_labels": 0}}
+        picture, plotter = _draw_plane(grid, style, label, bar, window, outlines, nodal)
     else:
         if "contact_pressure" in grid.point_data:
             grid.point_data[PRESSURE] = np.asarray(grid.point_data["contact_pressure"])
@@ -238,7 +243,7 @@ def _run_name(out: Path) -> str:
 
 
 def _draw_plane(grid, style: dict, label: str, bar: str, window: tuple[int, int],
-                outlines: list = ()):
+                outlines: list = (), nodal: bool = False):
     """2D: the whole body, and beside it a window on each small contact zone (as deformed.png).
 
     The zones are those of the step's contact pressure (any field is drawn
@@ -266,8 +271,20 @@ def _draw_plane(grid, style: dict, label: str, bar: str, window: tuple[int, int]
     picture = Picture(bar=bar)
     for column, (frame, title) in enumerate(views):
         plotter.subplot(0, column)
-        plotter.add_mesh(grid.copy(), show_edges=True, edge_color="#777777",
-                         **{**style, "show_scalar_bar": column == 0})
+        if nodal:  # a nodal state (stick/slip, active): on the nodes, never interpolated
+            plotter.add_mesh(grid.copy(), show_edges=True, edge_color="#9a9a9a",
+                             color="#eeeeee")
+            on = np.asarray(grid.point_data[style["scalars"]]) > 0
+            if np.any(on):
+                nodes = pyvista.PolyData(np.asarray(grid.points)[on])
+                nodes.point_data[style["scalars"]] = np.asarray(
+                    grid.point_data[style["scalars"]])[on]
+                plotter.add_mesh(nodes, render_points_as_spheres=True,
+                                 point_size=12 if column else 9,
+                                 **{**style, "show_scalar_bar": column == 0})
+        else:
+            plotter.add_mesh(grid.copy(), show_edges=True, edge_color="#777777",
+                             **{**style, "show_scalar_bar": column == 0})
         if pressed is not None and pressed.n_cells:
             plotter.add_mesh(pressed.copy(), scalars=PRESSURE, cmap=style["cmap"],
                              clim=[0.0, float(np.max(grid.point_data[PRESSURE]))],
@@ -278,6 +295,7 @@ def _draw_plane(grid, style: dict, label: str, bar: str, window: tuple[int, int]
         plotter.camera.parallel_projection = True
         if zooms or outlines:  # the bodies framed, not the obstacles' lines
             _frame(plotter, frame, aspect=width / (1 + len(zooms)) / window[1])
+        if zooms:
             plotter.add_text(title, position="lower_left", font_size=10)
         picture.panels.append(title)
     plotter.subplot(0, 0)
