@@ -179,7 +179,7 @@ def test_2d_stick_slip_is_drawn_on_the_nodes_by_category(tmp_path):
     out = tmp_path / "slide"
     assert run_scene(load_scene(SCENES / "block_slide_friction.toml"), out, pictures=False,
                      comm=MPI.COMM_SELF).path.converged
-    png, picture = draw_step(out, field="stick_slip", path=tmp_path / "s.png")
+    png, _ = draw_step(out, field="stick_slip", path=tmp_path / "s.png")
     image = imread(png)[..., :3]
     red = np.all(np.abs(image - np.array([0xd6, 0x27, 0x28]) / 255.0) < 0.08, axis=2)
     blue = np.all(np.abs(image - np.array([0x1f, 0x77, 0xb4]) / 255.0) < 0.08, axis=2)
