@@ -156,6 +156,8 @@ def read_pairs(path: Path, data: dict[str, Any], dimension: int = 2) -> tuple[Pa
     out = []
     for reader in _array(path, data, "pair"):
         self_contact = reader.flag("self_contact", False)
+        two_surfaces = reader.table.get("target", reader.table.get("striker")) != \
+            reader.table.get("striker")
         if self_contact:  # one surface against itself: the target defaults to the striker
             reader.table.setdefault("target", reader.table.get("striker"))
         elif "neighbourhood" in reader.table:
@@ -175,7 +177,7 @@ def read_pairs(path: Path, data: dict[str, Any], dimension: int = 2) -> tuple[Pa
             tangential_r_max=reader.number("tangential_r_max", 2.0, positive=True),
             self_contact=self_contact,
             neighbourhood=reader.number("neighbourhood", 3.0, positive=True),
-            discretisation=_discretisation(reader, dimension),
+            discretisation=_discretisation(reader, dimension, two_surfaces),
         ))
     _refuse_repeated_surfaces(path, out)
     return tuple(out)
@@ -200,14 +202,26 @@ def _refuse_repeated_surfaces(path: Path, pairs: list[PairSpec]) -> None:
         seen[key] = pair.name
 
 
-def _discretisation(reader: _Reader, dim: int) -> str:
-    """[[pair]] discretisation: "node-to-segment" (default) or "mortar"."""
+def _discretisation(reader: _Reader, dim: int, two_surfaces: bool) -> str:
+    """[[pair]] discretisation: "node-to-segment" (default) or "mortar".
+
+    A mortar pair joins two disjoint surfaces: of two bodies, or two surfaces
+    of one body (self_contact = true with a target other than the striker).
+    """
     value = reader.table.get("discretisation", "node-to-segment")
     if value not in ("node-to-segment", "mortar"):
         raise reader.fail("discretisation", 'choose "node-to-segment" (the default) or "mortar".')
     if value == "mortar" and reader.flag("self_contact", False):
-        raise reader.fail("discretisation", "mortar pairs two bodies; a self-contact pair is "
-                          '"node-to-segment".')
+        if not two_surfaces:
+            raise reader.fail(
+                "discretisation", "a mortar pair joins two surfaces: with self_contact = true "
+                "give a target, the part of the body's surface the striker meets, tagged apart "
+                "from the striker (as scenes/tube_crush.toml does); one surface against itself "
+                'is "node-to-segment".')
+        if "neighbourhood" in reader.table:
+            raise reader.fail(
+                "neighbourhood", "belongs to node-to-segment self-contact; a mortar pair "
+                "pairs only facets that face each other and needs no neighbourhood: remove it.")
     return value
 
 

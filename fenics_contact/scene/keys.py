@@ -220,7 +220,7 @@ KEY_DOCS: dict[str, dict[str, KeyDoc]] = {
                                 field="PairSpec.neighbourhood"),
         "discretisation": KeyDoc('"node-to-segment" | "mortar"', "Node-to-segment, or mortar "
                                  "(exact on non-matching meshes; 2D and 3D, with or without "
-                                 "friction).",
+                                 "friction; self-contact of two surfaces of one body too).",
                                  field="PairSpec.discretisation"),
     },
     "pairing": {
