@@ -338,3 +338,35 @@ def test_a_roller_face_against_an_inclined_wall_with_friction(tmp_path):
     # the supports hold the body against the wall's push and friction
     np.testing.assert_allclose(problem.support_total() + state.contact_force * n + friction,
                                0.0, atol=1e-8 * state.contact_force)
+
+
+def test_a_roller_on_one_body_of_a_frictional_pair_is_no_symmetry_plane(tmp_path):
+    """block_on_block, mu = 0.3, the striker's side x = 0 held in x, the target's side free.
+
+    The target is clamped at its base; its top corner at x = 0 moves in x
+    under the load, so the slip of the striker node held there is not zero
+    and its traction is not zero by symmetry. Before, the plane was taken for
+    a symmetry cut, that traction was masked, and every attempt of the first
+    step was refused ("slip at sticking nodes 3.75e-05").
+    """
+    root = Path(__file__).parent.parent
+    text = (root / "scenes" / "block_on_block_node_to_segment.toml").read_text()
+    text = text.replace('"../meshes/block_on_block.geo"', f'"{root / "meshes/block_on_block.geo"}"')
+    text = text.replace('target = "target_face"', 'target = "target_face"\nmu = 0.3', 1)
+    text = text.replace("E = 200.0", "E = 1000.0", 1)
+    text = text.replace('tag = "bottom"\nvalue = ["free", 0.0]',
+                        'tag = "bottom"\nvalue = [0.0, 0.0]')
+    text = text.replace('tag = "symmetry"\nvalue', 'tag = "symmetry"\ny = [0.5, 1.0]\nvalue')
+    path = tmp_path / "roller.toml"
+    path.write_text(text + "\n[output]\npictures = false\n")
+    outcome = run_scene(load_scene(path), tmp_path / "out", comm=MPI.COMM_SELF)
+    assert outcome.path.status == "converged"
+    assert outcome.path.iterations <= 10  # 7 measured
+    problem = outcome.problem
+    assert problem.symmetry_constraints == 0
+    state = problem.contact_state()
+    on_plane = np.isclose(problem.nodal_coordinates()[:, 0], 0.0)
+    assert on_plane.sum() == 1
+    t, p = np.abs(state.tangential_traction[on_plane][0]), -state.pressure[on_plane][0]
+    assert 0.05 * 0.3 * p < t <= 0.3 * p * (1 + 1e-9)  # friction acts at the held node
+    assert np.allclose(outcome.summary["steps"][-1]["reaction_total"], 0.0, atol=1e-10)

@@ -204,6 +204,8 @@ class CoulombFriction:
         for facets, axis, name in holds:
             symmetric = name is None
             held = fem.locate_dofs_topological(W, fdim, facets)
+            if symmetric and not self._plane_cuts_partner(W, held):
+                continue  # a roller on one body of a pair: the slip across it is free
             nodes = np.flatnonzero(np.isin(parent[:n_owned], held))
             along = np.abs(frame[nodes, axis, :])
             j = np.argmax(along, axis=1) if nodes.size else np.zeros(0, int)
@@ -229,6 +231,22 @@ class CoulombFriction:
             self.held.x.array[: n_owned * k] = constrained.reshape(-1).astype(float)
             self.held.x.scatter_forward()
         return self.comm.allreduce(int(np.sum(constrained)), op=MPI.SUM)
+
+    def _plane_cuts_partner(self, W: fem.FunctionSpace, held: np.ndarray) -> bool:
+        """Whether a symmetry plane's held nodes include the partner surface's (collective).
+
+        Against a rigid obstacle, always. On a pair the plane is one only when
+        it cuts both bodies: a roller that holds the striker's body alone
+        (an axis held on one body of a stack) leaves the slip across it free,
+        the target point moving, so the node's traction there is no more zero
+        by symmetry than anywhere else.
+        """
+        target = getattr(self.contact, "target_facets", None)
+        if target is None:
+            return True
+        fdim = self.contact.domain.topology.dim - 1
+        partner = fem.locate_dofs_topological(W, fdim, np.asarray(target, np.int32))
+        return bool(self.comm.allreduce(bool(np.isin(partner, held).any()), op=MPI.LOR))
 
     def _refuse_oblique_hold(self, nodes: np.ndarray, axis: int, name: str) -> None:
         """Refuse a held axis that is neither along nor across the obstacle's normal.
