@@ -118,6 +118,7 @@ class MortarTransfer:
                                      2.0 * Xj - Xs[np.maximum(other, 0)])
             self._m[:, s] = has
             self._src[:, s] = self.striker.vertices[self._idx[:, s]]
+        self._excluded = self._shared_vertex_pairs()
         self.assignment = np.full((n_w, self.slots), -2, np.int64)
         self.version = 0
         self.search_count = 0
@@ -160,6 +161,26 @@ class MortarTransfer:
             self.version += 1
             return True
         return False
+
+    def _shared_vertex_pairs(self) -> tuple[np.ndarray, np.ndarray]:
+        """(node, target facet) pairs never paired: the facet holds the node or a neighbour.
+
+        Only two surfaces of one body share vertices (self-contact, where they
+        meet at a fold or a notch's root). A node's own corner is no contact:
+        paired, a node on the shared vertex pressed against a facet it belongs
+        to and carried a force the displacements never feel.
+        """
+        shared = np.intersect1d(self.striker.vertices, self.target.vertices)
+        if shared.size == 0:
+            return np.zeros(0, np.int64), np.zeros(0, np.int64)
+        stencil = np.column_stack([self.me, self._idx[:, 0], self._idx[:, 1]])
+        stencil = self.striker.vertices[stencil]  # global blocks (n, 3)
+        facets = self.target.vertices[self.target.facet_vertex]  # global blocks (m, 2)
+        rows = np.flatnonzero(np.isin(stencil, shared).any(axis=1))
+        cols = np.flatnonzero(np.isin(facets, shared).any(axis=1))
+        hit = (stencil[rows][:, None, :, None] == facets[cols][None, :, None, :]).any(axis=(2, 3))
+        r, c = np.nonzero(hit)
+        return rows[r], cols[c]
 
     def passed_through(self) -> np.ndarray:
         """Depth of each owned striker node inside the target body, where it has passed through.
@@ -207,6 +228,7 @@ class MortarTransfer:
             sc[self.sides[s] < 0] = -np.inf
             near |= np.any((sc > 0.0) & (dist < NEAR), axis=1)
             scores = np.maximum(scores, sc)
+        scores[self._excluded] = -np.inf
         return scores, near
 
     def sources(self) -> list[np.ndarray]:

@@ -41,7 +41,7 @@ from dolfinx import fem
 from fenics_contact.model.contact import ContactSurface
 from fenics_contact.model.segment_forms3d import SegmentForms, provenance_weights
 from fenics_contact.model.segments import Polyline, any_rank, node_blocks
-from fenics_contact.model.segments3d import segment_surfaces
+from fenics_contact.model.segments3d import candidate_pairs, segment_pairs
 
 #: Segments per striker triangle the segment mesh is first made for (it grows when needed).
 SEGMENTS_PER_TRIANGLE = 8
@@ -103,6 +103,11 @@ class MortarTransfer3D:
         self._capacity = max(SEGMENTS_PER_TRIANGLE * (hi - lo), 16)
         self._segment_forms: dict[str, SegmentForms] = {}
         self.lam = lam
+        shared = np.intersect1d(self.striker.vertices, self.target.vertices)
+        #: Striker triangles with a vertex on the target surface (None: the surfaces meet
+        #: nowhere, as on two bodies).
+        self._meeting = (np.isin(self.striker.vertices[self.striker.facet_vertex], shared)
+                         .any(axis=1) if shared.size else None)
         self.engaged_count = 0
         self.version = 0
         self.search_count = 0
@@ -147,7 +152,7 @@ class MortarTransfer3D:
         xs = (s.X + s.displacements(self.u))[s.facet_vertex]
         xt = (t.X + t.displacements(self.u))[t.facet_vertex]
         lo, hi = s.owned
-        seg = segment_surfaces(xs[lo:hi], xt, self.reach)
+        seg = self._segments(xs[lo:hi], xt)
         k = len(seg)
         self.segment_count = int(self.comm.allreduce(k))
         vertices = np.concatenate([xs[lo:hi][seg.striker], xt[seg.target]], axis=1)
@@ -195,6 +200,26 @@ class MortarTransfer3D:
         self.G.x.array[:] = G[self.q_vertex]
         self.version += 1
         return True
+
+    def _segments(self, xs: np.ndarray, xt: np.ndarray):
+        """Segments of this rank's striker triangles ``xs`` against the target ``xt``.
+
+        Pairs of triangles that share a vertex are not clipped: only two
+        surfaces of one body share vertices (self-contact, where they meet), and
+        a corner's own triangles are no contact (a node on it would press
+        against a triangle it belongs to).
+        """
+        s_idx, t_idx = candidate_pairs(xs, xt, self.reach)
+        if self._meeting is not None and s_idx.size:
+            lo = self.striker.owned[0]
+            mine = self.striker.vertices[self.striker.facet_vertex[s_idx + lo]]
+            theirs = self.target.vertices[self.target.facet_vertex[t_idx]]
+            near = self._meeting[s_idx + lo]
+            touch = (mine[near][:, :, None] == theirs[near][:, None, :]).any(axis=(1, 2))
+            keep = np.ones(s_idx.size, bool)
+            keep[np.flatnonzero(near)[touch]] = False
+            s_idx, t_idx = s_idx[keep], t_idx[keep]
+        return segment_pairs(xs, xt, s_idx, t_idx)
 
     def _gathered_rows(self, name: str) -> sp.csr_matrix:
         """A per-segment (3 x 18) derivative summed into striker-node rows and V-dof columns."""
