@@ -70,7 +70,8 @@ def test_a_single_obstacle_scene_is_one_entry_named_obstacle():
      "[contact] goes with a single [obstacle]; with [[obstacle]] blocks give each block its own "
      "contact keys"),
     (FLOOR + FLOOR, "[[obstacle]] names ['floor', 'floor'] repeat"),
-    (FLOOR.replace('tag = "bottom"', 'tag = "bottom"\nmue = 0.3'), "unknown key 'mue'"),
+    (FLOOR.replace('tag = "bottom"', 'tag = "bottom"\nmue = 0.3'),
+     "unknown key 'mue' at [obstacle 'floor']"),
     (FLOOR.replace('tag = "bottom"', 'detect = true\ntag = "bottom"'),
      "[obstacle 'floor'] needs either 'tag'"),
     (FLOOR.replace('tag = "bottom"', 'tag = "bottom"\nr = -1.0'), "[obstacle 'floor'] r = -1.0"),

@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from fenics_contact.model.contact import r_problem
-from fenics_contact.scene.reader import _array, _check_keys, _Reader, _table
+from fenics_contact.scene.reader import _array, _block_name, _check_keys, _Reader, _table
 from fenics_contact.scene.sections import read_bounds
 from fenics_contact.scene.spec import (
     ContactSpec,
@@ -53,7 +53,7 @@ def read_obstacle_blocks(path: Path, data: dict[str, Any], dimension: int
         )
     out = []
     for i, table in enumerate(blocks):
-        _check_keys(path, "obstacles", table)
+        _check_keys(path, "obstacles", table, _block_name("obstacle", i, table))
         name = table.get("name", f"obstacle{i + 1}")
         if not isinstance(name, str) or not name:
             raise SceneError(f"{path.name}: [[obstacle]] {i + 1} name = {name!r}: give a word.")

@@ -124,11 +124,11 @@ def warn_pressure_scatter(scene: Scene, problem: ContactProblem) -> float:
                    "contact stress (e.g. few elements through a thin wall). Refine it there; "
                    "another discretisation of the pair would not help.")
         elif contact.self_contact and np.array_equal(contact.facets, contact.target_facets):
-            why = ("the nodes sample the partner's facets unevenly on meshes that do not "
-                   "match, and refining does not remove it. One surface paired with itself "
-                   "is node-to-segment only: to get a smooth pressure, tag the two parts that "
-                   'meet apart and pair them with discretisation = "mortar" (docs/contacts.md). '
-                   "The resultant is right either way.")
+            why = ("one surface paired with itself holds a closed contact from both sides, "
+                   "and the equations do not fix how its force splits between the facing "
+                   "nodes (each facing pair sums to the profile); the resultant is right. For "
+                   "a smooth pressure, tag the two parts that meet apart and pair them with "
+                   'discretisation = "mortar" (docs/contacts.md).')
         else:
             why = ("the nodes sample the partner's facets unevenly on meshes that do not "
                    "match, and refining does not remove it. discretisation = \"mortar\" gives "

@@ -128,17 +128,26 @@ class _Reader:
         return value
 
 
-def _check_keys(path: Path, section: str, table: dict[str, Any]) -> None:
+def _check_keys(path: Path, section: str, table: dict[str, Any],
+                where: str | None = None) -> None:
+    """Refuse a key the section does not know; ``where`` names the block (else the section)."""
     allowed = KEYS[section]
     for key in table:
         if key not in allowed:
             close = difflib.get_close_matches(key, sorted(allowed), n=1)
             hint = f" Did you mean {close[0]!r}?" if close else ""
-            where = f"[{section}]" if section else "top level"
+            where = where or (f"[{section}]" if section else "top level")
             raise SceneError(
                 f"{path.name}: unknown key {key!r} at {where}.{hint} "
                 f"Allowed: {', '.join(sorted(allowed))}."
             )
+
+
+def _block_name(section: str, index: int, table: dict[str, Any]) -> str:
+    """How a message names the index-th [[section]] block: by its name, else its number."""
+    name = table.get("name")
+    return (f"[{section} {name!r}]" if isinstance(name, str) and name
+            else f"[[{section}]] {index + 1}")
 
 
 def _non_finite(value: object) -> list[str | int] | None:
@@ -189,6 +198,6 @@ def _array(path: Path, data: dict[str, Any], section: str) -> list[_Reader]:
     items = data.get(section, [])
     if not isinstance(items, list) or not all(isinstance(t, dict) for t in items):
         raise SceneError(f"{path.name}: use [[{section}]] blocks for {section} conditions.")
-    for t in items:
-        _check_keys(path, section, t)
+    for i, t in enumerate(items):
+        _check_keys(path, section, t, _block_name(section, i, t))
     return [_Reader(path, f"[{section}]", t) for t in items]
