@@ -199,6 +199,8 @@ class CoulombFriction:
             for i in range(self.gdim)
         ], axis=1)  # (owned nodes, gdim, d-1)
         constrained = np.zeros((n_owned, k), dtype=bool)
+        across = np.zeros((n_owned, self.gdim), dtype=bool)
+        symmetric_rows = np.zeros((n_owned, k), dtype=bool)
         mask = self.contact.normal_mask
         free_gap = np.ones(n_owned, bool) if mask is None else mask.x.array[:n_owned] > 0.5
         for facets, axis, name in holds:
@@ -225,6 +227,13 @@ class CoulombFriction:
             # a held axis across the frame leaves the slip free along the tangents: no
             # zero Jacobian row, nothing to treat
             constrained[nodes[aligned], j[aligned]] = True
+            if symmetric:
+                across[nodes[aligned], axis] = True
+                symmetric_rows[nodes[aligned], j[aligned]] = True
+        #: Owned nodes' global axes and frame components across a symmetry plane: the
+        #: traction there is zero by symmetry, also as reported (a mortar pair's nodal
+        #: means would let a neighbour's traction in).
+        self.across_symmetry = (across, symmetric_rows)
         self.symmetry_mask.x.array[: n_owned * k] = np.where(constrained.reshape(-1), 0.0, 1.0)
         self.symmetry_mask.x.scatter_forward()
         if self._slip_is_data:
@@ -382,8 +391,21 @@ class CoulombFriction:
         """
         traction_forms = (self._multiplier_forms[1] if self._reports_multipliers
                           else self._global_forms[0])
-        return (self.contact.reported(self._nodal_components(traction_forms)),
+        return (self._reported_traction(self._nodal_components(traction_forms)),
                 self._nodal_components(self._global_forms[1]))
+
+    def _reported_traction(self, values: np.ndarray, frame: bool = False) -> np.ndarray:
+        """The contact's reported nodal traction, zero across symmetry planes.
+
+        ``values``: (n, gdim) in global axes, or (n, d - 1) frame components
+        (``frame``).
+        """
+        out = np.array(self.contact.reported(values), copy=True).reshape(values.shape)
+        masks = getattr(self, "across_symmetry", None)
+        if masks is not None and out.size:
+            mask = masks[1] if frame else masks[0]
+            out.reshape(out.shape[0], -1)[mask[: out.shape[0]].reshape(out.shape[0], -1)] = 0.0
+        return out
 
     def tangential_force_vector(self) -> np.ndarray:
         """Global int T tau dA (force; per thickness in 2D): minus the friction on the body."""
@@ -402,8 +424,8 @@ class CoulombFriction:
         multipliers = self._reports_multipliers
         return FrictionalContactState(**{
             **normal,
-            "tangential_traction": self.contact.reported(self._nodal_components(
-                self._multiplier_forms[0] if multipliers else self._tau_forms)),
+            "tangential_traction": self._reported_traction(self._nodal_components(
+                self._multiplier_forms[0] if multipliers else self._tau_forms), frame=True),
             "slip": self._nodal_components(self._slip_forms),
             "coulomb_limit": self.contact.reported(self._pressure_and_radius()[1]),
             "node_state": states,
