@@ -238,6 +238,50 @@ def test_a_geometry_gmsh_cannot_mesh_is_named_without_a_traceback(tmp_path, caps
                      r"1D mesh seems not to be forming a closed loop", err), err
 
 
+EXTRUDED_APART_GEO = """Geometry.AutoCoherence = 0;  // two boxes kept apart, extruded
+Point(1) = {0, 0, 0}; Point(2) = {1, 0, 0}; Point(3) = {1, 1, 0}; Point(4) = {0, 1, 0};
+Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 1};
+Curve Loop(1) = {1, 2, 3, 4}; Plane Surface(1) = {1};
+Transfinite Curve {1, 2, 3, 4} = 3; Transfinite Surface {1}; Recombine Surface {1};
+b[] = Extrude {0, 0, 0.5} { Surface{1}; Layers{2}; Recombine; };
+Point(101) = {0, 0, 0.5}; Point(102) = {0.5, 0, 0.5}; Point(103) = {0.5, 0.5, 0.5};
+Point(104) = {0, 0.5, 0.5};
+Line(101) = {101, 102}; Line(102) = {102, 103}; Line(103) = {103, 104}; Line(104) = {104, 101};
+Curve Loop(101) = {101, 102, 103, 104}; Plane Surface(101) = {101};
+Transfinite Curve {101, 102, 103, 104} = 3; Transfinite Surface {101}; Recombine Surface {101};
+a[] = Extrude {0, 0, 0.5} { Surface{101}; Layers{2}; Recombine; };
+Physical Volume("lower", 1) = {b[1]}; Physical Volume("upper", 2) = {a[1]};
+Physical Surface("bottom", 1) = {1}; Physical Surface("lower_top", 2) = {b[0]};
+Physical Surface("upper_bottom", 3) = {101}; Physical Surface("upper_top", 4) = {a[0]};
+Physical Surface("sym", 5) = {b[2], a[2]};
+"""
+
+
+def test_a_facet_group_off_the_cells_is_named_not_an_mpi_abort(tmp_path):
+    """Extrude under AutoCoherence = 0: the side faces get nodes of their own.
+
+    DOLFINx, handed such a tagged face, aborted the process with "Invalid
+    rank has value 1" (a serial run, exit 6, no word about the mesh).
+    """
+    from mpi4py import MPI
+
+    from fenics_contact.scene.build import build_mesh
+
+    (tmp_path / "apart.geo").write_text(EXTRUDED_APART_GEO)
+    (tmp_path / "apart.toml").write_text(
+        '[scene]\nname = "apart"\ndimension = 3\n[mesh]\nfile = "apart.geo"\n'
+        '[[body]]\nname = "lower"\ntag = "lower"\nlaw = "linear"\nE = 100.0\nnu = 0.3\n'
+        '[[body]]\nname = "upper"\ntag = "upper"\nlaw = "linear"\nE = 100.0\nnu = 0.3\n'
+        '[[pair]]\nstriker = "upper_bottom"\ntarget = "lower_top"\n'
+        '[[dirichlet]]\ntag = "bottom"\nvalue = [0.0, 0.0, 0.0]\n'
+        '[[dirichlet]]\ntag = "upper_top"\nvalue = [0.0, 0.0, -0.01]\n'
+        '[[dirichlet]]\ntag = "sym"\nvalue = ["free", 0.0, "free"]\n')
+    scene = load_scene(tmp_path / "apart.toml")
+    with pytest.raises(SceneError, match=r"the physical group 'sym' holds Surface \d+, whose "
+                       r"mesh has \d+ nodes that no 3D cell uses.*OpenCASCADE"):
+        build_mesh(scene, MPI.COMM_SELF)
+
+
 def test_a_msh_file_whose_nodes_are_numbered_with_gaps_runs(tmp_path):
     """gmsh numbers a file's nodes as it pleases (1 ... N with gaps after edits): renumbered."""
     import gmsh

@@ -46,7 +46,13 @@ from fenics_contact.scene.checks import (
     warn_locking,
     warn_skipped_knots,
 )
-from fenics_contact.scene.meshing import gmsh_session, mesh_on_rank, open_geo, overlapping_groups
+from fenics_contact.scene.meshing import (
+    MeshGroupError,
+    gmsh_session,
+    mesh_on_rank,
+    open_geo,
+    overlapping_groups,
+)
 from fenics_contact.scene.pairing import pairing_contacts
 from fenics_contact.scene.schema import (
     GENERATOR_TAGS,
@@ -190,6 +196,8 @@ def _from_gmsh(scene: Scene, comm: MPI.Comm) -> BodyMesh:
 
     try:
         data = mesh_on_rank(comm, 0, scene.dimension, build)
+    except MeshGroupError as exc:
+        raise SceneError(f"{scene.path.name}: [mesh] file = {str(spec.file)!r}: {exc}") from None
     except ValueError as exc:
         raise SceneError(f"{scene.path.name}: [mesh] file = {str(spec.file)!r}: gmsh could not "
                          f"mesh it ({exc}); check the geometry (closed curve loops, surfaces "

@@ -15,6 +15,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from dolfinx.io.gmsh import MeshData, model_to_mesh
 
 from mpi4py import MPI
@@ -65,26 +66,65 @@ def mesh_on_rank(
     if comm.rank != rank:
         import gmsh
 
-        problem = comm.bcast(None, root=rank)
+        problem, kind = comm.bcast(None, root=rank)
         if problem:
-            raise ValueError(problem)
+            raise kind(problem)
         return model_to_mesh(gmsh.model, comm, rank, gdim=gdim)
     with gmsh_session() as (gmsh, opened):
         try:
-            problem = ""
+            problem, kind = "", ValueError
             try:
                 build(gmsh)
                 gmsh.model.mesh.renumberNodes()
                 gmsh.model.mesh.renumberElements()
             except Exception as exc:  # gmsh raises bare Exception
                 problem = " ".join(str(exc).split()) or type(exc).__name__
-            comm.bcast(problem, root=rank)
+            if not problem:
+                problem, kind = facets_off_the_cells(gmsh, gdim), MeshGroupError
+            comm.bcast((problem, kind), root=rank)
             if problem:
-                raise ValueError(problem)
+                raise kind(problem)
             return model_to_mesh(gmsh.model, comm, rank, gdim=gdim)
         finally:
             if not opened:
                 gmsh.model.remove()
+
+
+class MeshGroupError(ValueError):
+    """A meshed model whose physical groups cannot become mesh tags."""
+
+
+def facets_off_the_cells(gmsh: Any, gdim: int) -> str:
+    """Why a facet group of the meshed model is not on its cells ("" when every one is).
+
+    Every node of a facet physical group must be a node of some cell:
+    DOLFINx finds each tagged facet among its cells' facets, and one that
+    is not there aborted the whole process with an MPI error (seen with
+    ``Geometry.AutoCoherence = 0`` and extruded boxes, whose side surfaces
+    then got nodes of their own).
+    """
+    used: set[int] = set()
+    for dim, tag in gmsh.model.getEntities(gdim):
+        for nodes in gmsh.model.mesh.getElements(dim, tag)[2]:
+            used.update(np.asarray(nodes, np.int64).tolist())
+    kinds = {1: "Curve", 2: "Surface"}
+    for dim, group in gmsh.model.getPhysicalGroups(gdim - 1):
+        name = gmsh.model.getPhysicalName(dim, group) or str(group)
+        for entity in gmsh.model.getEntitiesForPhysicalGroup(dim, group):
+            nodes = np.concatenate([np.asarray(n, np.int64) for n in
+                                    gmsh.model.mesh.getElements(dim, int(entity))[2]] or
+                                   [np.zeros(0, np.int64)])
+            off = int(np.setdiff1d(nodes, np.fromiter(used, np.int64, len(used))).size)
+            if off:
+                return (f"the physical group {name!r} holds {kinds[gdim - 1]} {int(entity)}, "
+                        f"whose mesh has {off} nodes that no {gdim}D cell uses: that surface "
+                        "is not meshed as a face of the bodies' cells. The built-in kernel's "
+                        "Extrude under Geometry.AutoCoherence = 0 does this (the extruded "
+                        "volume's top nodes are not its side faces' nodes); mesh the bodies "
+                        "apart another way, e.g. with the OpenCASCADE kernel (SetFactory("
+                        "\"OpenCASCADE\"), one Box per body, no BooleanFragments between them) "
+                        "and physical groups of their faces.")
+    return ""
 
 
 def overlapping_groups(gmsh: Any) -> str:
