@@ -312,3 +312,15 @@ def test_a_new_run_removes_the_earlier_runs_pictures_and_renders_only(tmp_path, 
     _replace_earlier_run(MPI.COMM_SELF, out)
     assert sorted(p.name for p in out.iterdir()) == ["my_render.png", "notes.txt"]
     assert "held an earlier run" in capsys.readouterr().err
+
+
+def test_several_contacts_are_named_each_with_its_force(tmp_path, capsys):
+    """Their sum would add the floor's force to the forces between the blocks."""
+    scene = SCENES / "stack_3_blocks.toml"
+    assert main(["run", str(scene), "--out", str(tmp_path / "out"), "--no-pictures"]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if "max penetration" in x)
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    last = summary["steps"][-1]["contacts"]
+    assert len(last) >= 2
+    named = ", ".join(f"{name} {c['normal_force']:.6g}" for name, c in last.items())
+    assert f"; contact forces {named}, max penetration" in line
