@@ -277,6 +277,29 @@ def test_a_striker_pushed_through_the_target_in_one_step_is_refused_then_cut_bac
     assert step.contact_force == pytest.approx(200.0 / (1 - 0.3**2) * 0.3, rel=1e-6)
 
 
+def test_a_striker_node_past_the_segment_search_is_named_as_a_mortar_one() -> None:
+    """The surface check's refusal speaks of the mortar pair, not of a node-to-segment vertex.
+
+    The upper block moved 0.3 down (2.4 h, past the reach 2 h = 0.25): every
+    striker node has lost its segments and its weighted gap reads open.
+    """
+    from fenics_contact.solvers.diagnostics import signorini_admissibility
+
+    problem, _ = _blocks(8, 11, "mortar")
+    V = problem.V
+    upper = problem.solid.cell_tags.find(STRIKER_TAG)
+    blocks = np.unique(V.dofmap.list[upper].reshape(-1))
+    problem.u.x.array.reshape(-1, 2)[blocks, 1] = -0.3
+    problem.u.x.scatter_forward()
+    state = problem.contact_state()
+    assert state.constraint_penetration == 0.0  # the weighted gaps see nothing
+    assert state.max_penetration == pytest.approx(0.3, rel=1e-12)
+    message = signorini_admissibility(problem, SolverSettings())()
+    assert message.startswith("penetration into the target surface 0.3 > surface_tol * h")
+    assert "mortar pair has passed through the target deeper than its segment search" in message
+    assert "concave vertex" not in message
+
+
 def test_stability_grid_mortar_case_at_huge_r() -> None:
     """The mortar group of the stability grid: auto at r = 1e12 E/h meets GNRM at r = 1.
 

@@ -497,6 +497,24 @@ def test_a_scene_error_is_printed_once_on_two_processes(tmp_path, capsys):
     assert all("unknown key 'stpes'" in line for line in err)
 
 
+@pytest.mark.mpi
+def test_a_failed_load_step_is_printed_once_on_two_processes(tmp_path, capsys):
+    from mpi4py import MPI
+
+    folder = Path(MPI.COMM_WORLD.bcast(str(tmp_path), root=0))
+    path = folder / "stiff.toml"
+    if MPI.COMM_WORLD.rank == 0:  # one Newton iteration and no cut-back cannot converge
+        write(folder, edit(solver__max_iterations=1, solver__max_cutbacks=0)(base()),
+              name="stiff.toml")
+    MPI.COMM_WORLD.barrier()
+    assert main(["run", str(path), "--out", str(folder / "out"), "--quiet"]) == 1
+    err = [line for line in capsys.readouterr().err.strip().splitlines()
+           if "did not converge" in line]
+    assert len(err) == (1 if MPI.COMM_WORLD.rank == 0 else 0), err
+    assert all(line.startswith("fenics-contact: load step 1 of 1 did not converge")
+               for line in err)
+
+
 def test_output_folder_not_writable(tmp_path, monkeypatch):
     import tempfile
 
@@ -639,6 +657,38 @@ def test_mortar_bodies_starting_deep_inside_each_other_are_refused(tmp_path):
         _build(path)
 
 
+def test_mortar_bodies_overlapping_beyond_the_segment_search_are_refused(tmp_path):
+    """0.3 = 2.4 h, past the reach 2 h = 0.25: no segment, the weighted gaps read open.
+
+    The depth by closest point refuses it before any Newton iteration (the
+    scene used to run 218 iterations and fail on the surface check).
+    """
+    path = _overlapping(tmp_path, 0.3)
+    path.write_text(path.read_text().replace(
+        'target = "target_face"', 'target = "target_face"\ndiscretisation = "mortar"'))
+    with pytest.raises(SceneError, match=r"the bodies 'upper' and 'lower' start 0.3 inside each "
+                       r"other near \([0-9.]+, 0.2\), more than the striker facet size "
+                       r"h = 0.125"):
+        _build(path)
+
+
+def test_3d_mortar_bodies_overlapping_beyond_the_segment_search_are_refused(tmp_path):
+    """block_on_block_3d.geo, the upper block 0.4 down (3.9 h, past the reach 0.25)."""
+    geo = (MESHES / "block_on_block_3d.geo").read_text()
+    for old in ("Box(1) = {0, 0, H, W, W, H};", "2 * H - e, W + e, W + e, 2 * H + e}"):
+        assert old in geo
+    geo = geo.replace("Box(1) = {0, 0, H, W, W, H};", "Box(1) = {0, 0, H - 0.4, W, W, H};")
+    geo = geo.replace("2 * H - e, W + e, W + e, 2 * H + e}",
+                      "2 * H - 0.4 - e, W + e, W + e, 2 * H - 0.4 + e}")
+    (tmp_path / "overlap3d.geo").write_text(geo)
+    text = (MESHES.parent / "scenes" / "block_on_block_3d.toml").read_text()
+    text = text.replace('"../meshes/block_on_block_3d.geo"', f'"{tmp_path / "overlap3d.geo"}"')
+    text = text.replace("h_upper = 0.125, h_lower = 0.17", "h_upper = 0.1, h_lower = 0.1")
+    with pytest.raises(SceneError, match=r"the bodies 'upper' and 'lower' start 0.4 inside each "
+                       r"other near \(.*, 0.1\), more than the striker facet size h = 0.1"):
+        _build(write(tmp_path, text, name="overlap3d.toml"))
+
+
 def test_shallow_initial_overlap_is_reported_and_runs(tmp_path):
     from fenics_contact.scene.checks import SceneWarning
 
@@ -647,16 +697,29 @@ def test_shallow_initial_overlap_is_reported_and_runs(tmp_path):
         _build(_overlapping(tmp_path, 0.01))
 
 
-def test_near_incompressible_linear_elements_are_warned_about(tmp_path):
-    """nu = 0.4999 locks P1 elements: built, with a warning that names the effect and the fix."""
+@pytest.mark.parametrize("nu", [0.48, 0.49, 0.4999])
+def test_near_incompressible_linear_elements_are_warned_about(tmp_path, nu):
+    """From nu = 0.48 on P1 elements lock: built, with a warning naming the effect and the fix.
+
+    (2D Hertz, a soft half-disk on a stiff block: peak +4 % at 0.48, +6 to +9 % at 0.49 with
+    neighbouring nodes up to 30 % of the peak apart; within 2 % at 0.45.)
+    """
     from fenics_contact.scene.checks import SceneWarning
 
-    with pytest.warns(SceneWarning, match=r"\[material\] nu = 0.4999: the linear elements lock "
-                      r".*use nu <= 0.49 where contact pressures matter"):
-        _build(write(tmp_path, edit(material__nu=0.4999)(base())))
+    with pytest.warns(SceneWarning, match=rf"\[material\] nu = {nu}: the linear elements lock "
+                      r".*jumps from node to node.*\+6 to \+9 % at 0\.49.*No mixed or "
+                      r"locking-free formulation is offered: where contact pressures matter "
+                      r"use nu <= 0\.45"):
+        _build(write(tmp_path, edit(material__nu=nu)(base())))
+
+
+def test_nu_below_the_locking_threshold_is_not_warned_about(tmp_path):
+    from fenics_contact.scene.checks import LOCKING_NU, SceneWarning
+
+    assert LOCKING_NU == 0.48
     with warnings.catch_warnings():
         warnings.simplefilter("error", SceneWarning)
-        _build(write(tmp_path, edit(material__nu=0.49)(base()), name="ok.toml"))
+        _build(write(tmp_path, edit(material__nu=0.47)(base()), name="ok.toml"))
 
 
 def test_boundary_nodes_outside_the_tag_inside_an_obstacle_are_warned_about(tmp_path):

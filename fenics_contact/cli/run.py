@@ -140,12 +140,12 @@ def _solve(
     path = outcome.path
     if not path.converged:
         failed = path.steps[-1]
-        print(
-            f"fenics-contact: load step {failed.step} of {steps} did not converge "
-            f"({failed.message or failed.status}); {_kept(failed.step - 1, out)}"
-            f"{_advice(scene, failed.status, getattr(outcome.problem, 'initial_overlap', None))}",
-            file=sys.stderr,
-        )
+        if MPI.COMM_WORLD.rank == 0:  # the same on every process: said once
+            advice = _advice(scene, failed.status,
+                             getattr(outcome.problem, "initial_overlap", None))
+            print(f"fenics-contact: load step {failed.step} of {steps} did not converge "
+                  f"({failed.message or failed.status}); {_kept(failed.step - 1, out)}"
+                  f"{advice}", file=sys.stderr)
         return 1
     if not quiet:
         s = outcome.summary

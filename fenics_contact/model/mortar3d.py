@@ -39,6 +39,7 @@ import scipy.sparse as sp
 from dolfinx import fem
 
 from fenics_contact.model.contact import ContactSurface
+from fenics_contact.model.search import penetration_depth
 from fenics_contact.model.segment_forms3d import SegmentForms, provenance_weights
 from fenics_contact.model.segments import Polyline, any_rank, node_blocks
 from fenics_contact.model.segments3d import candidate_pairs, segment_pairs
@@ -97,6 +98,8 @@ class MortarTransfer3D:
                   np.repeat(_triangle_areas(tris)[:, None] / 3.0, 3, axis=1))
         edges = [np.linalg.norm(np.roll(t, 1, axis=1) - t, axis=-1).max()
                  for t in (tris, self.target.X[self.target.facet_vertex])]
+        #: The longest striker triangle edge (reference, length).
+        self.striker_size = float(edges[0])
         self.reach = 2.0 * max(edges)
         self.n_dofs = V.dofmap.index_map.size_global * 3
         lo, hi = self.striker.owned
@@ -220,6 +223,20 @@ class MortarTransfer3D:
             keep[np.flatnonzero(near)[touch]] = False
             s_idx, t_idx = s_idx[keep], t_idx[keep]
         return segment_pairs(xs, xt, s_idx, t_idx)
+
+    def passed_through(self) -> np.ndarray:
+        """Depth of each owned striker node inside the target body, where it has passed through.
+
+        As in 2D (:meth:`.mortar.MortarTransfer.passed_through`): closest point
+        and pseudo-normal on the target triangles; only depths beyond half the
+        longest striker edge count (else 0). A node deeper than the search's
+        ``reach`` has no segment and its gap reads open (length).
+        """
+        s, t = self.striker, self.target
+        points = (s.X + s.displacements(self.u))[self.q_vertex[: self.n_owned]]
+        current = (t.X + t.displacements(self.u))[t.facet_vertex]
+        depth = penetration_depth(points, current)
+        return np.where(depth > 0.5 * self.striker_size, depth, 0.0)
 
     def _gathered_rows(self, name: str) -> sp.csr_matrix:
         """A per-segment (3 x 18) derivative summed into striker-node rows and V-dof columns."""

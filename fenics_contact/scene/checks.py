@@ -17,6 +17,7 @@ from dolfinx import mesh
 
 from mpi4py import MPI
 
+from fenics_contact.model.materials import LOCKING_NOTE, LOCKING_NU
 from fenics_contact.model.mortar import MortarContact
 from fenics_contact.model.problem import PrescribedDisplacement
 from fenics_contact.model.rigid import free_assembly_motion, free_rigid_motions
@@ -172,10 +173,6 @@ def check_pair_surfaces(
         )
 
 
-#: Poisson's ratio above which the linear elements lock noticeably (a warning).
-LOCKING_NU = 0.49
-
-
 def warn_skipped_knots(scene: Scene) -> list[float]:
     """Warn when a frictional scene's load steps pass over a knot of a path or schedule.
 
@@ -209,14 +206,10 @@ def _landing_steps(knots: list[float], at_least: int) -> int:
 
 
 def warn_locking(scene: Scene, nu: float, where: str) -> None:
-    """Warn that P1 displacements lock near incompressibility (pressures far too high)."""
-    if LOCKING_NU < nu < 0.5:  # (0.5 and above are refused with the reason)
+    """Warn from nu = LOCKING_NU on that P1 displacements lock (pressures high and scattered)."""
+    if LOCKING_NU <= nu < 0.5:  # (0.5 and above are refused with the reason)
         warnings.warn(
-            SceneWarning(
-                f"{scene.path.name}: {where} nu = {nu:g}: the linear elements lock as nu nears "
-                f"0.5 (2D Hertz: peak pressure +6 % at nu = 0.49, +176 % at 0.4999); use "
-                f"nu <= {LOCKING_NU:g} where contact pressures matter."
-            ),
+            SceneWarning(f"{scene.path.name}: {where} nu = {nu:g}: {LOCKING_NOTE}."),
             stacklevel=2,
         )
 
@@ -440,9 +433,12 @@ def check_initial_overlap(scene: Scene, problem: ContactProblem) -> float:
 
     Over every deformable pair: on a node-to-segment pair the depth of the
     striker nodes whose projection falls on a target facet; on a mortar pair
-    the weighted gaps (each striker node's normal gap averaged over its
-    support). A shallower overlap is resolved by the first step and reported
-    as a :class:`SceneWarning`. Returns the largest depth (length).
+    (2D and 3D) the weighted gaps (each striker node's normal gap averaged
+    over its support) and, for a node deeper than the segment search reaches
+    (2 facet sizes), where its weighted gap reads open, its depth inside the
+    target body by closest point. A shallower overlap is resolved by the
+    first step and reported as a :class:`SceneWarning`. Returns the largest
+    depth (length).
     """
     deepest = 0.0
     for contact in problem.contacts:
@@ -451,7 +447,7 @@ def check_initial_overlap(scene: Scene, problem: ContactProblem) -> float:
         elif isinstance(contact, MortarContact):
             # the weighted gaps of touching curved bodies read slightly negative
             # (each side's facets cut the other's circle): warn past 1e-3 h only
-            depth, warn_from = np.maximum(-contact.contact_state().gap, 0.0), 1e-3
+            depth, warn_from = _mortar_depth(contact), 1e-3
         else:
             continue
         deepest = max(deepest, _refuse_deep_overlap(scene, contact, depth, warn_from))
@@ -463,6 +459,17 @@ def _projected_depth(contact) -> np.ndarray:
     state = contact.contact_state()
     on_facet = contact.pair.projection.overshoot[: state.gap.size] <= 1e-12
     return np.where(on_facet, -state.gap, 0.0)
+
+
+def _mortar_depth(contact: MortarContact) -> np.ndarray:
+    """Depth of each owned striker node of a mortar pair inside the target (length, >= 0).
+
+    The larger of -G (the weighted gap) and the closest-point depth of a node
+    that has passed through (beyond half a striker facet): a node farther
+    inside than the segment search reaches has no segment, and G reads open.
+    """
+    weighted = np.maximum(-contact.contact_state().gap, 0.0)
+    return np.maximum(weighted, contact.mortar.passed_through())
 
 
 def _refuse_deep_overlap(scene: Scene, contact, depth: np.ndarray, warn_from: float) -> float:
@@ -499,6 +506,7 @@ def _refuse_deep_overlap(scene: Scene, contact, depth: np.ndarray, warn_from: fl
 
 
 __all__ = [
+    "LOCKING_NU",
     "SceneWarning",
     "check_bodies_held",
     "check_cells",

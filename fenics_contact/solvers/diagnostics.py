@@ -317,11 +317,22 @@ def _signorini_violation(contact, settings: SolverSettings, E: float) -> str | N
     two_body = state.constraint_penetration is not None
     if violation is None and two_body and inside > settings.surface_tol * h:
         violation = (f"penetration into the target surface {inside:.3g} > surface_tol * h = "
-                     f"{settings.surface_tol:g} * {h:.3g} (a striker node inside the target: "
-                     "held on the extension of a facet it has passed, at a concave vertex of "
-                     "a node-to-segment target, which a mortar pair, discretisation = "
-                     "\"mortar\", avoids; or pushed through it by too large a step)")
+                     f"{settings.surface_tol:g} * {h:.3g} ({_inside_target_cause(contact)})")
     return violation
+
+
+def _inside_target_cause(contact) -> str:
+    """Why a striker node of a converged iterate can lie inside the target, per discretisation."""
+    from fenics_contact.model.mortar import MortarContact
+
+    if isinstance(contact, MortarContact):
+        return ("a striker node of the mortar pair has passed through the target deeper than "
+                "its segment search reaches (2 facet sizes): its weighted gap finds no target "
+                "facet and reads open; pushed through by too large a step, or the bodies "
+                "started inside each other")
+    return ("a striker node inside the target: held on the extension of a facet it has "
+            "passed, at a concave vertex of a node-to-segment target, which a mortar pair, "
+            "discretisation = \"mortar\", avoids; or pushed through it by too large a step")
 
 
 def coulomb_admissibility(
