@@ -126,8 +126,8 @@ Physical Surface("right_flank", 3) = {out[4]}; Physical Surface("tip", 4) = {out
 Physical Surface("faces", 5) = {1, out[0]};"""
 
 
-def _notch(tmp_path: Path, dim: int, pair: str) -> dict:
-    """The notched cantilever's end pushed down 0.9 in 30 steps; its summary."""
+def _notch_scene(tmp_path: Path, dim: int, pair: str) -> Path:
+    """The notched cantilever's end pushed down 0.9 in 30 steps: the scene file."""
     geo = tmp_path / f"notch{dim}.geo"
     geo.write_text(NOTCH_GEO.format(extrude="Extruded 0.1 along z." if dim == 3 else "",
                                     h=0.04 if dim == 2 else 0.08, hn=0.01 if dim == 2 else 0.02,
@@ -166,7 +166,14 @@ steps = 30
 [output]
 pictures = false
 """)
-    outcome = run_scene(load_scene(scene), tmp_path / name, comm=MPI.COMM_SELF, pictures=False)
+    return scene
+
+
+def _notch(tmp_path: Path, dim: int, pair: str) -> dict:
+    """The notched cantilever run; its last step's summary."""
+    scene = _notch_scene(tmp_path, dim, pair)
+    outcome = run_scene(load_scene(scene), tmp_path / scene.stem, comm=MPI.COMM_SELF,
+                        pictures=False)
     assert outcome.path.converged
     return outcome.summary["steps"][-1]
 
@@ -190,3 +197,20 @@ def test_a_notch_closing_from_its_root_is_node_to_segment_s(tmp_path, dim):
     assert tip[0] == pytest.approx(tip[1], rel=1e-3)
     if dim == 2:
         assert force[0] > 0.02  # the notch is closed at its root
+
+
+def test_a_node_inside_its_own_neighbourhood_names_the_neighbourhood(tmp_path, capsys):
+    """Node-to-segment, neighbourhood 3: the notch closes from its root, inside it.
+
+    The nodes there may never be paired with those facets, so no step size
+    or method helps; the message used to blame a concave vertex and advise
+    `auto` and more steps (step 11 of 30 refused at every cut-back).
+    """
+    from fenics_contact.cli import main
+
+    scene = _notch_scene(tmp_path, 2, "neighbourhood = 3.0")
+    assert main(["run", str(scene), "--out", str(tmp_path / "out"), "--no-pictures"]) == 1
+    err = capsys.readouterr().err
+    assert "inside target facets of its own neighbourhood (3 facet sizes" in err
+    assert "lower [[pair]] neighbourhood (e.g. 1)" in err
+    assert "To try" not in err

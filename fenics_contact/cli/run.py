@@ -142,7 +142,8 @@ def _solve(
         failed = path.steps[-1]
         if MPI.COMM_WORLD.rank == 0:  # the same on every process: said once
             advice = _advice(scene, failed.status,
-                             getattr(outcome.problem, "initial_overlap", None))
+                             getattr(outcome.problem, "initial_overlap", None),
+                             failed.message or "")
             print(f"fenics-contact: load step {failed.step} of {steps} did not converge "
                   f"({failed.message or failed.status}); {_kept(failed.step - 1, out)}"
                   f"{advice}", file=sys.stderr)
@@ -201,14 +202,18 @@ def _count(n: int, noun: str) -> str:
     return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
 
 
-def _advice(scene: Scene, status: str, overlap: str | None = None) -> str:
+def _advice(scene: Scene, status: str, overlap: str | None = None, message: str = "") -> str:
     """What to try after a failed load step (nothing for a stop that is not the solver's).
 
     ``overlap``: the body's initial overlap with an obstacle, when it was warned
-    about; first on the list, since no solver setting mends it.
+    about; first on the list, since no solver setting mends it. ``message``:
+    the failed step's; when it already names the one fix (a node inside its
+    own self-contact neighbourhood), no solver setting is suggested.
     """
     if status not in ("cycling", "diverged", "max_iterations", "inverted"):
         return ""
+    if "cannot help: lower [[pair]] neighbourhood" in message:
+        return "."
     method = scene.solver.method
     tips = []
     if overlap:

@@ -39,7 +39,14 @@ from scipy.sparse.csgraph import dijkstra
 from mpi4py import MPI
 
 from fenics_contact.model.pairs import DeformablePair
-from fenics_contact.model.search import KEEP, TIE_TOL, Projection, facet_normals, project
+from fenics_contact.model.search import (
+    KEEP,
+    TIE_TOL,
+    Projection,
+    facet_normals,
+    penetration_depth,
+    project,
+)
 
 #: Default neighbourhood radius, in facet sizes along the surface.
 NEIGHBOURHOOD = 3.0
@@ -267,6 +274,22 @@ class SelfContactPair(DeformablePair):
         gap = np.einsum("ij,ij->i", self.striker_positions()[:n] - current[facet, 0],
                         facet_normals(current)[facet])
         return np.maximum(-(gap + self.lift.x.array.reshape(-1, self.gdim)[:n, 0]), 0.0)
+
+    def inside_own_neighbourhood(self, depth: float) -> bool:
+        """Whether a node lies deeper than ``depth`` inside a facet of its own neighbourhood.
+
+        Two surfaces only (else False): the search never pairs a node with
+        those facets, so no step size holds it out of them; a smaller
+        ``neighbourhood`` does (a notch closing from its root). Collective.
+        """
+        found = False
+        if self.two_surfaces:
+            points, current, nearest = self._closest_on_surface()
+            inside = penetration_depth(points, current, size=self._size, nearest=nearest,
+                                       free=self.target.free) > depth
+            rows = np.flatnonzero(inside)
+            found = bool(np.asarray(self.excluded[rows, nearest.facet[rows]]).any())
+        return bool(self.comm.allreduce(found, op=MPI.LOR))
 
     def _node_normals(self) -> np.ndarray:
         """Current normal of each striker node: the sum of its surface facets' unit normals."""

@@ -317,13 +317,26 @@ def _signorini_violation(contact, settings: SolverSettings, E: float) -> str | N
     two_body = state.constraint_penetration is not None
     if violation is None and two_body and inside > settings.surface_tol * h:
         violation = (f"penetration into the target surface {inside:.3g} > surface_tol * h = "
-                     f"{settings.surface_tol:g} * {h:.3g} ({_inside_target_cause(contact)})")
+                     f"{settings.surface_tol:g} * {h:.3g} "
+                     f"({_inside_target_cause(contact, settings.surface_tol * h)})")
     return violation
 
 
-def _inside_target_cause(contact) -> str:
-    """Why a striker node of a converged iterate can lie inside the target, per discretisation."""
+def _inside_target_cause(contact, depth: float) -> str:
+    """Why a striker node of a converged iterate can lie inside the target, per discretisation.
+
+    ``depth``: the depth that counts (length). Collective.
+    """
     from fenics_contact.model.mortar import MortarContact
+
+    pair = getattr(contact, "pair", None)
+    inside_own = getattr(pair, "inside_own_neighbourhood", None)
+    if inside_own is not None and inside_own(depth):
+        return (f"a striker node inside target facets of its own neighbourhood "
+                f"({pair.neighbourhood:g} facet sizes along the surface), which the "
+                "self-contact search never pairs it with, so smaller steps or another method "
+                "cannot help: lower [[pair]] neighbourhood (e.g. 1), or pair the two "
+                'surfaces with discretisation = "mortar"')
 
     if isinstance(contact, MortarContact):
         return ("a striker node of the mortar pair has passed through the target deeper than "
