@@ -83,3 +83,22 @@ def test_the_block_left_free_is_the_one_named(tmp_path):
     with pytest.raises(SceneError, match=r"\[\[body\]\] 'middle' can move rigidly "
                        r"\(translation in x\).*on a face of 'middle'"):
         build_problem(load_scene(path), MPI.COMM_SELF)
+
+
+def test_every_single_free_motion_is_named(tmp_path):
+    """The half tube between its plates without its cut: free to slide in x and to turn.
+
+    Both are named; before, one mix of them was (a rotation about (0, -2)).
+    """
+    from mpi4py import MPI
+
+    from fenics_contact.scene.build import build_problem
+    from fenics_contact.scene.schema import SceneError, load_scene
+
+    shipped = Path(__file__).parent.parent / "scenes" / "tube_crush.toml"
+    text = shipped.read_text().replace('"../meshes/', f'"{shipped.parent.parent / "meshes"}/')
+    path = tmp_path / "tube.toml"
+    path.write_text(text.replace('[[dirichlet]]\ntag = "cut"\nvalue = [0.0, "free"]\n', ""))
+    with pytest.raises(SceneError, match=r"'tube' can move rigidly \(translation in x and "
+                       r"rotation in the x-y plane about \(0, 0\)\)"):
+        build_problem(load_scene(path), MPI.COMM_SELF)

@@ -134,6 +134,7 @@ def _describe(mode: np.ndarray, centre: np.ndarray, size: float, gdim: int) -> s
             return f"translation along ({_fmt(a / np.linalg.norm(a))})"
         # u = a + w (-y, x) vanishes at the point c with a = w (c_y, -c_x)
         c = np.array([-a[1] / w, a[0] / w]) * size + centre
+        c = np.where(np.abs(c) < 1e-6 * size, 0.0, c)  # the modes' round-off
         return f"rotation in the x-y plane about ({_fmt(c)})"
     a, w = mode[:3], mode[3:]
     if np.linalg.norm(w) < 1e-8:
@@ -141,6 +142,7 @@ def _describe(mode: np.ndarray, centre: np.ndarray, size: float, gdim: int) -> s
     axis = w / np.linalg.norm(w)
     # a = -w x c (+ a screw part along w); c = (w x a) / |w|^2 is the nearest axis point
     c = np.cross(w, a) / np.dot(w, w) * size + centre
+    c = np.where(np.abs(c) < 1e-6 * size, 0.0, c)
     return f"rotation about the axis ({_fmt(axis)}) through ({_fmt(c)})"
 
 
@@ -187,8 +189,6 @@ def free_assembly_motion(
         free motion found moves; empty when every rigid motion is held.
         Collective.
     """
-    from scipy.optimize import linprog
-
     gdim = domain.geometry.dim
     tdim = domain.topology.dim
     comm = domain.comm
@@ -237,8 +237,38 @@ def free_assembly_motion(
         columns.append((contact_gaps(u) - base)[closed] / step)
     local = np.column_stack(columns) if columns else np.zeros((0, free.shape[1]))
     resist = np.vstack(comm.allgather(local))
-    # a free motion: resist c >= 0 (no closed node penetrates), c != 0; look along each axis
-    k = free.shape[1]
+    pure, coefficients = _pure_free_modes(free, resist, bodies, centre, gdim)
+    if pure:
+        # what else is free, apart from the pure modes (a rotation about another point)
+        rest = _complement(coefficients, free.shape[1])
+        c = _lp_free_motion(resist @ rest) if rest.shape[1] else None
+        if c is not None:
+            extra = dict(_moving_bodies(free @ rest @ c, bodies, centre, size, gdim))
+            pure = [(name, f"{what} and {extra[name]}" if name in extra else what)
+                    for name, what in pure]
+        return pure
+    c = _lp_free_motion(resist, free.shape[1])
+    return [] if c is None else _moving_bodies(free @ c, bodies, centre, size, gdim)
+
+
+def _complement(columns: list[np.ndarray], k: int) -> np.ndarray:
+    """An orthonormal basis (k, m) of the complement of ``columns`` in R^k."""
+    if not columns:
+        return np.eye(k)
+    q, r = np.linalg.qr(np.column_stack(columns), mode="complete")
+    rank = int(np.sum(np.abs(np.diag(r)) > 1e-10))
+    return q[:, rank:]
+
+
+def _lp_free_motion(resist: np.ndarray, k: int | None = None) -> np.ndarray | None:
+    """Coefficients c of a motion with resist c >= 0 (no closed node closes) and c != 0.
+
+    Linear programs along each axis of the coefficients (bounds +-1); None
+    when every motion closes some closed node.
+    """
+    from scipy.optimize import linprog
+
+    k = resist.shape[1] if k is None else k
     for j in range(k):
         for sign in (1.0, -1.0):
             objective = np.zeros(k)
@@ -249,8 +279,39 @@ def free_assembly_motion(
                              b_ub=np.full(resist.shape[0], 1e-9) if resist.size else None,
                              bounds=[(-1.0, 1.0)] * k, method="highs")
             if result.status == 0 and -result.fun > 1e-3:
-                return _moving_bodies(free @ result.x, bodies, centre, size, gdim)
-    return []
+                return result.x
+    return None
+
+
+def _pure_free_modes(free: np.ndarray, resist: np.ndarray,
+                     bodies: Sequence[tuple[str, np.ndarray]], centre: np.ndarray,
+                     gdim: int) -> tuple[list[tuple[str, str]], list[np.ndarray]]:
+    """The single rigid modes (a translation along an axis, a rotation about the centre) free.
+
+    Named first, each of them: a ring between two plates without a cut is
+    free to slide in x and to turn, and a mix of the two (a rotation about a
+    point below it) named only one of them. Per body, its free modes joined;
+    also the coefficients (in the columns of ``free``) of each mode found.
+    """
+    n_modes = 3 if gdim == 2 else 6
+    names = _names(gdim)
+    out, coefficients = [], []
+    for i, (name, _) in enumerate(bodies):
+        motions = []
+        for k in range(n_modes):
+            e = np.zeros(free.shape[0])
+            e[i * n_modes + k] = 1.0
+            c = free.T @ e
+            if np.linalg.norm(free @ c - e) > 1e-8:
+                continue  # a condition holds it
+            closing = resist @ c if resist.size else np.zeros(0)
+            if np.all(closing >= -1e-9) or np.all(closing <= 1e-9):
+                motions.append(names[k] + (f" about ({_fmt(centre)})" if "rotation" in names[k]
+                                           and gdim == 2 else ""))
+                coefficients.append(c)
+        if motions:
+            out.append((name, " and ".join(motions)))
+    return out, coefficients
 
 
 def _moving_bodies(mode: np.ndarray, bodies: Sequence[tuple[str, np.ndarray]],
