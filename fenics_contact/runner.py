@@ -30,6 +30,7 @@ from fenics_contact.scene.build import build_problem
 from fenics_contact.scene.checks import warn_untagged_penetration
 from fenics_contact.scene.pressure_scatter import warn_pressure_scatter
 from fenics_contact.scene.schema import Scene
+from fenics_contact.scene.self_overlap import warn_self_overlap
 from fenics_contact.scene.striker_advice import advise_striker
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.base import SolveResult
@@ -361,6 +362,7 @@ def run_scene(
     with _kept(notes):
         warn_untagged_penetration(scene, problem)
         warn_body_overlap(scene, problem)
+        warn_self_overlap(scene, problem)
         advise_striker(scene, problem)
         warn_pressure_scatter(scene, problem)
     summary = _write_summary(comm, out, scene, path, used, notes)

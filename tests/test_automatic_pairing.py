@@ -5,6 +5,9 @@ bounding boxes, the two interfaces are found with the hand-declared striker
 (equal facet sizes: the body given later strikes), and every contact's
 force and every nodal pressure equal the hand-declared run's. The same on
 the cylinder between two plates (the left cylinder's surface is finer).
+The faces of a symmetry cut are no contact surface: before, the stack's
+node on the cut x = 0 took half a cut facet into its lumped area and its
+pressure read -1.0989 against the declared pair's -2.1978.
 """
 
 from __future__ import annotations
@@ -60,19 +63,47 @@ def test_stack_automatic_pairs_match_the_declared_ones(tmp_path):
         assert states_a[name].active_count == state.active_count == 11
         ph, pa = pressures(problem_h, name), pressures(problem_a, name)
         assert sorted(ph) == sorted(pa)
-        # the same pressure at every node but the striker's corners, whose lumped area
-        # takes in half a side facet too: there the nodal force is the same
-        corners = [k for k in ph if k[0] in (0.0, 1.0)]
-        assert len(corners) == (2 if name != "floor" else 0) or name == "floor"
+        # the same pressure at every node but the striker's free corner x = 1, whose lumped
+        # area takes in half a side facet too: there the nodal force is the same. The
+        # node on the symmetry cut x = 0 reads the declared pressure (the cut is no surface)
+        corners = [k for k in ph if k[0] == 1.0]
+        assert len(corners) == (1 if name != "floor" else 0) or name == "floor"
         inner = [k for k in ph if k not in corners or name == "floor"]
+        assert any(k[0] == 0.0 for k in inner)
         assert np.allclose([pa[k] for k in inner], [ph[k] for k in inner], rtol=1e-8, atol=0)
         fh, fa = pressures(problem_h, name, True), pressures(problem_a, name, True)
         assert np.allclose([fa[k] for k in fh], list(fh.values()), rtol=1e-8, atol=0)
-    # the automatic contacts carry multipliers on the sides too (open there)
+    # the automatic contacts carry multipliers on the free sides too (open there), none on
+    # the cut: 14 striker nodes against the declared 11 (17 when the cut was a surface)
     for name in ("middle-on-bottom", "top-on-middle"):
         auto_c = next(c for c in problem_a.contacts if c.name == name)
         hand_c = next(c for c in problem_h.contacts if c.name == name)
-        assert auto_c.Q.dofmap.index_map.size_global > hand_c.Q.dofmap.index_map.size_global
+        assert auto_c.Q.dofmap.index_map.size_global == 14
+        assert hand_c.Q.dofmap.index_map.size_global == 11
+
+
+def test_only_symmetry_cuts_that_bound_the_mesh_are_set_aside():
+    """u_x = 0 on x = 0 with the mesh on one side is a cut; on a plane through the mesh
+    (a roller with material beyond it), or with u_x = 0.1, or holding both components, not."""
+    from dolfinx import mesh
+
+    from fenics_contact.model.automatic_pairing import symmetry_cut_facets
+    from fenics_contact.model.body import PrescribedDisplacement
+
+    domain = mesh.create_rectangle(MPI.COMM_SELF, [[0.0, 0.0], [2.0, 1.0]], [4, 2])
+    domain.topology.create_connectivity(1, 2)
+
+    def on(x0: float) -> np.ndarray:
+        return mesh.locate_entities(domain, 1, lambda x: np.isclose(x[0], x0))
+
+    def cut(facets: np.ndarray, value: tuple) -> int:
+        return symmetry_cut_facets(domain, [PrescribedDisplacement(facets, value)]).size
+
+    assert cut(on(0.0), (0.0, None)) == on(0.0).size == 2
+    assert cut(on(2.0), (0.0, None)) == 2  # the far side bounds the mesh too
+    assert cut(on(1.0), (0.0, None)) == 0  # the mesh lies on both sides
+    assert cut(on(0.0), (0.1, None)) == 0  # a moving roller: no symmetry
+    assert cut(on(0.0), (0.0, 0.0)) == 0  # clamped: may be struck
 
 
 def test_cylinder_automatic_pair_matches_the_declared_one(tmp_path):

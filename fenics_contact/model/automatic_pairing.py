@@ -5,7 +5,10 @@ For each unordered pair of bodies of a :class:`~.body.Solid`:
 1. **Surfaces.** Each body's candidate facets are its exterior facets
    (boundary facets of the mesh whose cell is the body's), whatever
    conditions they carry: a face held by a Dirichlet condition can still be
-   struck.
+   struck. The faces of a symmetry cut are not (:func:`symmetry_cut_facets`):
+   they stay on their plane and the model lies on one side of it, so nothing
+   can reach them, and a node on the cut would take part of a cut facet's
+   area into its lumped area (its pressure halved at a right-angled corner).
 2. **Bounding boxes.** The two bodies' reference bounding boxes, each
    enlarged by ``reach`` (the largest displacement the load path
    prescribes plus a margin, chosen by the caller), must overlap, or the
@@ -42,7 +45,7 @@ from mpi4py import MPI
 
 from fenics_contact.model.body import Body
 from fenics_contact.model.contact import ContactSettings
-from fenics_contact.model.friction import FrictionSettings
+from fenics_contact.model.friction import FrictionSettings, symmetry_planes
 from fenics_contact.model.pairs import NodeToSegmentContact
 
 #: Relative difference of mean facet sizes under which two surfaces count as equally fine.
@@ -109,6 +112,37 @@ def facets_near_box(domain: mesh.Mesh, facets: np.ndarray, lo: np.ndarray, hi: n
     return facets[meets]
 
 
+def _plane_bounds_mesh(domain: mesh.Mesh, facets: np.ndarray, axis: int) -> bool:
+    """Whether the whole mesh lies on one side of the plane of ``facets`` (collective).
+
+    The plane is x_axis = c, c read from the facets' nodes; one side within
+    1e-12 of the mesh's extent.
+    """
+    comm, x = domain.comm, domain.geometry.x[:, axis]
+    nodes = mesh.entities_to_geometry(domain, domain.topology.dim - 1, facets).ravel() \
+        if facets.size else np.zeros(0, np.int32)
+    c = comm.allreduce(float(np.min(x[nodes], initial=np.inf)), op=MPI.MIN)
+    lo = comm.allreduce(float(np.min(x, initial=np.inf)), op=MPI.MIN)
+    hi = comm.allreduce(float(np.max(x, initial=-np.inf)), op=MPI.MAX)
+    tol = 1e-12 * max(hi - lo, 1.0)
+    return bool(lo >= c - tol or hi <= c + tol)
+
+
+def symmetry_cut_facets(domain: mesh.Mesh, conditions: Sequence[object]) -> np.ndarray:
+    """Local facets of the symmetry cuts among Dirichlet ``conditions`` (collective).
+
+    A cut: a symmetry plane (:func:`~.friction.symmetry_planes`: one
+    displacement component held at 0 on facets in one plane normal to it)
+    with the whole mesh on one side. Its facets stay in the plane and nothing
+    lies beyond it: they can never be contact surfaces. Other held faces (a
+    clamped face, a prescribed push, a roller with bodies beyond its plane)
+    can be struck and are kept.
+    """
+    cuts = [facets for facets, axis in symmetry_planes(domain, conditions)
+            if _plane_bounds_mesh(domain, facets, axis)]
+    return np.unique(np.concatenate(cuts)).astype(np.int32) if cuts else np.zeros(0, np.int32)
+
+
 def automatic_contacts(
     domain: mesh.Mesh,
     cell_tags: mesh.MeshTags,
@@ -118,6 +152,7 @@ def automatic_contacts(
     *,
     skip: set[frozenset[str]] = frozenset(),
     friction: FrictionSettings | None = None,
+    cuts: np.ndarray | None = None,
 ) -> tuple[list[NodeToSegmentContact], list[tuple[str, str]]]:
     """One node-to-segment contact per pair of bodies whose enlarged boxes overlap.
 
@@ -130,6 +165,9 @@ def automatic_contacts(
             body's box is enlarged by it.
         skip: body pairs (frozensets of two names) already paired by hand.
         friction: Coulomb friction of every contact (None: frictionless).
+        cuts: local facets that are no contact surface (the symmetry cuts,
+            :func:`symmetry_cut_facets`); the boxes and facet sizes still
+            count them.
 
     Returns the contacts (named "<striker>-on-<target>") and the body pairs
     pruned by their boxes.
@@ -137,6 +175,8 @@ def automatic_contacts(
     surfaces = body_surfaces(domain, cell_tags, bodies)
     boxes = {b.name: surface_box(domain, surfaces[b.name]) for b in bodies}
     sizes = {b.name: mean_facet_size(domain, surfaces[b.name]) for b in bodies}
+    if cuts is not None and cuts.size:
+        surfaces = {name: np.setdiff1d(f, cuts).astype(np.int32) for name, f in surfaces.items()}
     contacts, pruned = [], []
     for i, a in enumerate(bodies):
         for b in bodies[i + 1:]:
@@ -164,4 +204,4 @@ def automatic_contacts(
 
 
 __all__ = ["automatic_contacts", "body_surfaces", "facets_near_box", "mean_facet_size",
-           "surface_box"]
+           "surface_box", "symmetry_cut_facets"]

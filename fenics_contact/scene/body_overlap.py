@@ -12,8 +12,8 @@ node of one against the whole boundary of the other (a closed surface: the
 pseudo-normal at the closest point tells inside from outside), and one
 warning per pair names the deepest node when it lies deeper than
 :data:`WARN_DEPTH` (node-to-segment) or :data:`WARN_DEPTH_MORTAR` striker
-facet sizes. A self-contact pair of two surfaces of one body is checked one
-way, the target's nodes against the striker surface (open, with its rim).
+facet sizes. A self-contact pair is left to the check of a body against
+itself (:mod:`.self_overlap`).
 """
 
 from __future__ import annotations
@@ -71,18 +71,11 @@ def warn_body_overlap(scene: Scene, problem: ContactProblem) -> float:
     for contact in problem.contacts:
         striker, target = getattr(contact, "striker_body", None), getattr(contact, "target_body",
                                                                           None)
-        if striker is None or target is None:
-            continue
-        if striker is target:  # self-contact: the target's nodes against the striker surface
-            one = np.array_equal(contact.facets, contact.target_facets)
-            if comm.allreduce(one, op=MPI.LAND):
-                continue  # one surface: every node is a striker node
-            found = [_inside(problem, contact.target_facets, contact.facets), (0.0, None)]
-        else:
-            surfaces = body_surfaces(problem.domain, problem.solid.cell_tags,
-                                     [target, striker])
-            sides = [surfaces[b.name] for b in (target, striker)]
-            found = [_inside(problem, sides[0], sides[1]), _inside(problem, sides[1], sides[0])]
+        if striker is None or target is None or striker is target:
+            continue  # self-contact: scene/self_overlap.py
+        surfaces = body_surfaces(problem.domain, problem.solid.cell_tags, [target, striker])
+        sides = [surfaces[b.name] for b in (target, striker)]
+        found = [_inside(problem, sides[0], sides[1]), _inside(problem, sides[1], sides[0])]
         depths = [comm.allreduce(d, op=MPI.MAX) for d, _ in found]
         which = int(np.argmax(depths))
         depth, h = depths[which], contact.surface.h
@@ -94,9 +87,7 @@ def warn_body_overlap(scene: Scene, problem: ContactProblem) -> float:
         point = comm.bcast(found[which][1], root=rank)
         inner, outer = ((target, striker), (striker, target))[which]
         where = ", ".join(f"{c:.4g}" for c in point[:gdim])
-        what = (f"a node of the target surface lies {depth:.3g} ({depth / h:.1%} of h) behind "
-                "the striker surface" if striker is target else
-                f"a boundary node of body {inner.name!r} lies {depth:.3g} ({depth / h:.1%} of h) "
+        what = (f"a boundary node of body {inner.name!r} lies {depth:.3g} ({depth / h:.1%} of h) "
                 f"inside body {outer.name!r}")
         declared = contact.name in {p.name for p in scene.pairs}
         label = f"[[pair]] {contact.name!r}" if declared else \
@@ -108,11 +99,6 @@ def warn_body_overlap(scene: Scene, problem: ContactProblem) -> float:
         elif mortar:
             fix = ("A mortar pair holds weighted gaps, not single nodes: refine both surfaces "
                    "where they touch, or tag the striker wherever the partner may reach.")
-        elif striker is target:
-            fix = ("The pair holds its striker nodes out of the target only: let the finer "
-                   "surface strike, or tag both surfaces as one and pair it with itself "
-                   "(striker = target: every node is held, though walls that meet node on node "
-                   "may then cycle; docs/contacts.md).")
         else:
             fix = ("The pair holds its striker nodes out of the target only: tag the striker "
                    "wherever the partner may reach, let the finer surface strike, or use "

@@ -380,7 +380,7 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
         [tagged_facets(body, scene, "pair", p.striker), tagged_facets(body, scene, "pair",
                                                                       p.target)])))
               for p in scene.pairs} if scene.pairing else set()
-    contacts += pairing_contacts(scene, body.domain, body.cell_tags, bodies, paired)
+    contacts += pairing_contacts(scene, body.domain, body.cell_tags, bodies, paired, prescribed)
     contacts += [obstacle_contact(scene, body, entry, bodies) for entry in scene.obstacles]
     solid = _solid(scene, body.domain, bodies, body.cell_tags, prescribed=prescribed,
                    tractions=tractions)

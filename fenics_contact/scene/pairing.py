@@ -14,7 +14,12 @@ from typing import Any
 import numpy as np
 from dolfinx import mesh
 
-from fenics_contact.model.automatic_pairing import automatic_contacts, body_surfaces, surface_box
+from fenics_contact.model.automatic_pairing import (
+    automatic_contacts,
+    body_surfaces,
+    surface_box,
+    symmetry_cut_facets,
+)
 from fenics_contact.model.body import Body
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.friction import FrictionSettings
@@ -51,12 +56,14 @@ def load_path_reach(scene: Scene) -> float:
 
 def pairing_contacts(
     scene: Scene, domain: mesh.Mesh, cell_tags: mesh.MeshTags, bodies: Sequence[Body],
-    paired: set[frozenset[str]],
+    paired: set[frozenset[str]], conditions: Sequence[object] = (),
 ) -> list[NodeToSegmentContact]:
     """The automatic contacts of a scene with [pairing] (none without it).
 
     Each body's box is enlarged by the load path's reach plus the margin
-    (default: a tenth of the smaller diagonal of the bodies' boxes).
+    (default: a tenth of the smaller diagonal of the bodies' boxes). The
+    faces of symmetry cuts among the Dirichlet ``conditions`` are no
+    contact surface (:func:`~.automatic_pairing.symmetry_cut_facets`).
     """
     spec = scene.pairing
     if spec is None:
@@ -70,7 +77,8 @@ def pairing_contacts(
     friction = None if spec.mu is None else FrictionSettings(spec.mu, spec.tangential_r_max)
     contacts, _ = automatic_contacts(
         domain, cell_tags, bodies, ContactSettings(r=spec.r, relative=spec.relative),
-        load_path_reach(scene) + margin, skip=paired, friction=friction)
+        load_path_reach(scene) + margin, skip=paired, friction=friction,
+        cuts=symmetry_cut_facets(domain, conditions))
     if not contacts and not scene.pairs:
         raise SceneError(
             f"{scene.path.name}: [pairing] automatic = true found no two bodies that can meet "
