@@ -25,7 +25,7 @@ from fenics_contact.output.folders import agree, write_failure
 from fenics_contact.output.io import write_json
 from fenics_contact.output.paraview import SCRIPT, write_paraview_script
 from fenics_contact.output.xdmf import StepWriter, finished_steps, step_files
-from fenics_contact.scene.body_overlap import warn_body_overlap
+from fenics_contact.scene.body_overlap import OverlapWatch, warn_body_overlap
 from fenics_contact.scene.build import build_problem
 from fenics_contact.scene.checks import warn_untagged_penetration
 from fenics_contact.scene.pressure_scatter import warn_pressure_scatter
@@ -328,7 +328,10 @@ def run_scene(
     if comm.rank == 0:
         write_paraview_script(out / "solution.xdmf", scene.fields, scene.dimension)
 
+    watch = OverlapWatch(problem)
+
     def finished(step: StepRecord) -> None:
+        watch.step(step.step, step.load_factor)
         step.reactions = problem.support_reactions()
         step.reaction_total = problem.support_total()
         writer.write(step.load_factor)
@@ -361,7 +364,7 @@ def run_scene(
         path.steps[-1].reaction_total = problem.support_total()
     with _kept(notes):
         warn_untagged_penetration(scene, problem)
-        warn_body_overlap(scene, problem)
+        warn_body_overlap(scene, problem, watch)
         warn_self_overlap(scene, problem)
         advise_striker(scene, problem)
         warn_pressure_scatter(scene, problem)

@@ -74,3 +74,38 @@ def test_an_automatic_contact_is_named_as_such_with_a_fix_that_applies(tmp_path)
     assert len(named) == 2
     assert all("[pairing] automatic contact '" in m and "declare these two bodies as a [[pair]]"
                in m for m in named)
+
+
+def test_an_overlap_at_an_earlier_step_is_named_with_its_step(tmp_path):
+    """Node-to-segment blocks slid off each other: the lower corner passes inside, then out.
+
+    The upper (coarser, striking) block is pressed 0.02 and slid 1.2 to the
+    right, past the lower block's end. At load step 26 the lower block's
+    corner lies 4.2 % of h inside the upper one; at the end the blocks have
+    parted. Before, only the last state was checked: nothing was said.
+    """
+    import json
+
+    text = (ROOT / "scenes" / "block_on_block_node_to_segment.toml").read_text()
+    text = text.replace('"../meshes/block_on_block.geo"',
+                        f'"{ROOT / "meshes" / "block_on_block.geo"}"')
+    text = text.replace('[[dirichlet]]\ntag = "symmetry"\nvalue = [0.0, "free"]\n', "")
+    text = text.replace('tag = "bottom"\nvalue = ["free", 0.0]',
+                        'tag = "bottom"\nvalue = [0.0, 0.0]')
+    text = text.replace('tag = "top"\nvalue = ["free", -0.01]',
+                        'tag = "top"\npath = [[0.0, 0.0, 0.0], [0.2, 0.0, -0.02], '
+                        "[1.0, 1.2, -0.02]]")
+    text = re.sub(r"steps = \d+", "steps = 40", text)
+    path = tmp_path / "slide.toml"
+    path.write_text(text + "\n[output]\npictures = false\n")
+    outcome = run_scene(load_scene(path), tmp_path / "out", comm=MPI.COMM_SELF)
+    assert outcome.path.converged
+    assert outcome.path.steps[-1].contact_force == 0.0  # parted
+    said = [w for w in json.loads((tmp_path / "out" / "summary.json").read_text())["warnings"]
+            if "inside body" in w]
+    assert len(said) == 1
+    found = re.search(r"at load step (\d+) \(load factor [\d.]+; the last step is clear of it\) "
+                      r"a boundary node of body 'lower' lies ([\d.e-]+) \(([\d.]+)% of h\) "
+                      r"inside body 'upper'", said[0])
+    assert found, said[0]
+    assert 20 < int(found.group(1)) < 36 and float(found.group(3)) > 100 * WARN_DEPTH
