@@ -309,3 +309,27 @@ def test_mortar3d_answer_independent_of_r_and_of_the_load_path() -> None:
         assert np.max(np.abs(run(r, 4)[0] - reference)) <= 1e-10 * scale, r
     assert run(100.0, 4, "auto")[1] == pytest.approx(force, rel=1e-10)
     assert np.max(np.abs(run(1.0, 1)[0] - reference)) <= 1e-8 * scale
+
+
+def test_a_striker_node_past_the_3d_segment_search_is_refused() -> None:
+    """The upper block moved 0.45 down, past the search's reach (2 x 0.17 = 0.34).
+
+    Every striker triangle has lost its segments and its weighted gap reads
+    open; by closest point the nodes lie 0.45 inside the lower block, and the
+    solvers' surface check refuses such an iterate (before, 3D mortar pairs
+    gave it no depth and it counted as open).
+    """
+    from fenics_contact.solvers.diagnostics import signorini_admissibility
+
+    problem, body = _patch(0.125, 0.17)
+    V = problem.V
+    upper = body.cell_tags.find(body.cell_names["striker"])
+    blocks = np.unique(V.dofmap.list[upper].reshape(-1))
+    problem.u.x.array.reshape(-1, 3)[blocks, 2] = -0.45
+    problem.u.x.scatter_forward()
+    state = problem.contact_state()
+    assert state.constraint_penetration == 0.0  # the weighted gaps see nothing
+    assert state.max_penetration == pytest.approx(0.45, rel=1e-9)
+    message = signorini_admissibility(problem, SolverSettings())()
+    assert message.startswith("penetration into the target surface 0.45 > surface_tol * h")
+    assert "mortar pair has passed through the target deeper than its segment search" in message

@@ -453,15 +453,13 @@ class MortarContact(Contact):
         return self.transfer.refresh()
 
     def penetration(self) -> float | None:
-        """2D: -min(G) of the weighted gaps, or the depth of a striker node that passed through.
+        """-min(G) of the weighted gaps, or the depth of a striker node that passed through.
 
         A node pushed deeper than the segment search reaches has no segment
         and counts as open; measured by closest point it is inside the
         target body, and the solvers' acceptance test refuses the iterate
-        (``surface_tol``). 3D: None (the weighted gaps alone).
+        (``surface_tol``). 2D and 3D alike.
         """
-        if self.gdim != 2:
-            return None
         passed = float(np.max(self.mortar.passed_through(), initial=0.0))
         weighted = float(np.max(-self.surface.nodal(self._gap_form), initial=0.0))
         return self.comm.allreduce(max(passed, weighted), op=MPI.MAX)
