@@ -102,3 +102,94 @@ def test_every_single_free_motion_is_named(tmp_path):
     with pytest.raises(SceneError, match=r"'tube' can move rigidly \(translation in x and "
                        r"rotation in the x-y plane about \(0, 0\)\)"):
         build_problem(load_scene(path), MPI.COMM_SELF)
+
+
+def _pressed_by_a_traction(tmp_path, traction: str, symmetry: bool = True):
+    """block_on_block with its top pushed by a traction instead of a displacement."""
+    from fenics_contact.scene.schema import load_scene
+
+    shipped = Path(__file__).parent.parent / "scenes" / "block_on_block.toml"
+    text = shipped.read_text().replace('"../meshes/', f'"{shipped.parent.parent / "meshes"}/')
+    text = text.replace('[[dirichlet]]\ntag = "top"\nvalue = ["free", -0.01]\n',
+                        f'[[traction]]\ntag = "top"\nvalue = {traction}\n')
+    if not symmetry:
+        text = text.replace('[[dirichlet]]\ntag = "symmetry"\nvalue = [0.0, "free"]\n', "")
+    path = tmp_path / "pushed.toml"
+    path.write_text(text + "\n[output]\npictures = false\n")
+    return load_scene(path)
+
+
+def test_a_body_pressed_on_its_partner_by_a_traction_is_held(tmp_path):
+    """Force control: the load presses the upper block into the contact that holds it.
+
+    Before, the scene was refused ("can move rigidly (translation in y)"):
+    the contact touching at load 0 holds nothing before it is pressed. The
+    pressure on the interface is the traction, 2.0 over the width 1.
+    """
+    from mpi4py import MPI
+
+    from fenics_contact import run_scene
+
+    scene = _pressed_by_a_traction(tmp_path, "[0.0, -2.0]")
+    outcome = run_scene(scene, tmp_path / "out", comm=MPI.COMM_SELF)
+    assert outcome.path.converged
+    assert outcome.path.steps[-1].contact_force == pytest.approx(2.0, rel=1e-10)
+
+
+@pytest.mark.parametrize(("traction", "symmetry", "free"), [
+    ("[0.0, 2.0]", True, "translation in y"),   # pulled off its partner
+    ("[0.0, -2.0]", False, "translation in x"),  # pressed, but free to slide sideways
+])
+def test_a_traction_that_does_not_press_a_body_home_holds_nothing(tmp_path, traction,
+                                                                   symmetry, free):
+    from mpi4py import MPI
+
+    from fenics_contact.scene.build import build_problem
+    from fenics_contact.scene.schema import SceneError
+
+    scene = _pressed_by_a_traction(tmp_path, traction, symmetry)
+    with pytest.raises(SceneError, match=rf"can move rigidly .*{free}"):
+        build_problem(scene, MPI.COMM_SELF)
+
+
+def test_a_block_pressed_on_a_rigid_floor_by_a_traction_is_held(tmp_path):
+    """One body on a rigid plane, force control: refused before, the floor takes 5 x 1."""
+    from mpi4py import MPI
+
+    from fenics_contact import run_scene
+    from fenics_contact.scene.schema import load_scene
+
+    path = tmp_path / "floor.toml"
+    path.write_text("""[scene]
+name = "pressed"
+dimension = 2
+[mesh]
+generator = "rectangle"
+origin = [0.0, 0.0]
+size = [1.0, 0.5]
+cells = [10, 5]
+[material]
+law = "neo-hookean"
+E = 100.0
+nu = 0.3
+[obstacle]
+type = "plane"
+point = [0.0, 0.0]
+normal = [0.0, 1.0]
+[contact]
+tag = "bottom"
+[[dirichlet]]
+tag = "left"
+value = [0.0, "free"]
+[[traction]]
+tag = "top"
+value = [0.0, -5.0]
+[solver]
+method = "gnrm"
+steps = 2
+[output]
+pictures = false
+""")
+    outcome = run_scene(load_scene(path), tmp_path / "out", comm=MPI.COMM_SELF)
+    assert outcome.path.converged
+    assert outcome.path.steps[-1].contact_force == pytest.approx(5.0, rel=1e-10)

@@ -164,6 +164,7 @@ def free_assembly_motion(
     bodies: Sequence[tuple[str, np.ndarray]],
     conditions: Sequence[tuple[np.ndarray, Sequence[float | None]]],
     contact_gaps: Callable[[np.ndarray], np.ndarray],
+    tractions: Sequence[tuple[np.ndarray, Sequence[float]]] = (),
 ) -> list[tuple[str, str]]:
     """A rigid motion of the assembly that nothing holds, body by body ([] when held).
 
@@ -174,7 +175,10 @@ def free_assembly_motion(
     closes no closed contact node, found by linear programs over the rigid
     modes the conditions leave free. The gap's change along each rigid mode
     is measured (a difference quotient), so rigid obstacles and deformable
-    pairs count alike; a frictionless contact holds nothing along it.
+    pairs count alike; a frictionless contact holds nothing along it. A
+    motion along which the surface tractions do negative work is held too:
+    the load presses the body into the contacts that resist it (a block
+    pushed onto a floor by a pressure), so the first load step closes them.
 
     Args:
         domain: the mesh of every body.
@@ -183,6 +187,8 @@ def free_assembly_motion(
             each Dirichlet condition.
         contact_gaps: the owned nodal gaps of every contact (joined) for a
             displacement given per geometry node, shape (nodes, gdim) (length).
+        tractions: (local facet indices, traction at load factor 1) of each
+            surface traction.
 
     Returns:
         (body name, its part of the motion in words) for each body that the
@@ -237,6 +243,10 @@ def free_assembly_motion(
         columns.append((contact_gaps(u) - base)[closed] / step)
     local = np.column_stack(columns) if columns else np.zeros((0, free.shape[1]))
     resist = np.vstack(comm.allgather(local))
+    work = free.T @ _mode_loads(domain, vertices, tractions, centre, size, n_modes)
+    if np.any(work):
+        # the loads' work along a motion: a motion they oppose (negative work) is held
+        resist = np.vstack([resist, work / np.abs(work).max()])
     pure, coefficients = _pure_free_modes(free, resist, bodies, centre, gdim)
     if pure:
         # what else is free, apart from the pure modes (a rotation about another point)
@@ -249,6 +259,51 @@ def free_assembly_motion(
         return pure
     c = _lp_free_motion(resist, free.shape[1])
     return [] if c is None else _moving_bodies(free @ c, bodies, centre, size, gdim)
+
+
+def _mode_loads(domain: mesh.Mesh, vertices: list[np.ndarray],
+                tractions: Sequence[tuple[np.ndarray, Sequence[float]]], centre: np.ndarray,
+                size: float, n_modes: int) -> np.ndarray:
+    """The tractions' work along each rigid mode of each body (scaled modes; collective).
+
+    int t . phi_k dA over each traction's owned facets, phi_k linear and t
+    constant: the facet's area times phi_k at its vertices' mean (exact on
+    segments and triangles).
+    """
+    gdim = domain.geometry.dim
+    tdim = domain.topology.dim
+    x = domain.geometry.x[:, :gdim]
+    owned = domain.topology.index_map(tdim - 1).size_local
+    out = np.zeros(n_modes * len(vertices))
+    for facets, value in tractions:
+        facets = np.asarray(facets, np.int32)
+        facets = facets[facets < owned]
+        if facets.size == 0 or not np.any(value):
+            continue
+        nodes = mesh.entities_to_geometry(domain, tdim - 1, facets)
+        area = _facet_areas(x[nodes])
+        centroid = (x[nodes].mean(axis=1) - centre) / size
+        for i, verts in enumerate(vertices):
+            on = np.isin(nodes[:, 0], verts)
+            for c, t in enumerate(value):
+                if t:
+                    out[i * n_modes:(i + 1) * n_modes] += float(t) * (
+                        area[on] @ _basis(centroid[on], c, gdim))
+    total = np.empty_like(out)
+    domain.comm.Allreduce(out, total, op=MPI.SUM)
+    return total
+
+
+def _facet_areas(points: np.ndarray) -> np.ndarray:
+    """Areas of facets (m, vertices, gdim): segments, triangles, quadrilaterals (DOLFINx order)."""
+    if points.shape[-1] == 2:
+        return np.linalg.norm(points[:, 1] - points[:, 0], axis=-1)
+    if points.shape[1] == 3:
+        return 0.5 * np.linalg.norm(np.cross(points[:, 1] - points[:, 0],
+                                             points[:, 2] - points[:, 0]), axis=-1)
+    # a quadrilateral 0, 1, 3, 2 around: half the cross product of its diagonals
+    return 0.5 * np.linalg.norm(np.cross(points[:, 3] - points[:, 0],
+                                         points[:, 2] - points[:, 1]), axis=-1)
 
 
 def _complement(columns: list[np.ndarray], k: int) -> np.ndarray:

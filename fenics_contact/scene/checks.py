@@ -382,7 +382,8 @@ def check_bodies_held(
         f"{scene.path.name}: {what}: no [[dirichlet]] condition holds that motion, and the "
         f"contacts do not hold it at the start: one open, or touching with no pressure yet, "
         f"holds nothing before the load presses it (nor along it: friction is not counted "
-        f"as a support). Fix: prescribe components on a face of {name!r} (e.g. a support, a "
+        f"as a support, and a traction holds only the motions it presses into a contact). "
+        f"Fix: prescribe components on a face of {name!r} (e.g. a support, a "
         "symmetry plane or a driven face: a prescribed displacement instead of a traction), "
         "or start it touching the parts that hold it."
     )
@@ -422,7 +423,7 @@ def free_motion_of_contacts(
 
     try:
         return free_assembly_motion(domain, bodies, [(p.facets, p.at(1.0)) for p in prescribed],
-                                    gaps)
+                                    gaps, [(t.facets, t.value) for t in problem.solid.tractions])
     finally:
         u.x.array[:] = 0.0
         problem.refresh_search()
