@@ -227,7 +227,9 @@ class CoulombFriction:
             # a held axis across the frame leaves the slip free along the tangents: no
             # zero Jacobian row, nothing to treat
             constrained[nodes[aligned], j[aligned]] = True
-            if symmetric:
+            if symmetric and not self._slip_is_data:
+                # (against a rigid obstacle a held node the obstacle drags slides: its
+                # traction is mu p, and reported as it is)
                 across[nodes[aligned], axis] = True
                 symmetric_rows[nodes[aligned], j[aligned]] = True
         #: Owned nodes' global axes and frame components across a symmetry plane: the
