@@ -313,6 +313,18 @@ class StrikerOnFacetProblem:
         """Largest |u - u_D| over the prescribed components (length, global)."""
         return self.solid.prescribed_mismatch()
 
+    def unheld_motion(self, gap_tol: float) -> list[tuple[str, str]]:
+        """A rigid motion of the body that its supports leave free ([] when they hold it).
+
+        The striker, one prescribed point on one facet, is not counted (the
+        paper's Example 1 is clamped on two faces); ``gap_tol`` is unused.
+        See :meth:`fenics_contact.model.problem.ContactProblem.unheld_motion`.
+        """
+        from fenics_contact.model.rigid import free_rigid_motions
+
+        conditions = [(p.facets, p.at(1.0)) for p in self.solid.prescribed]
+        return [("body", m) for m in free_rigid_motions(self.domain, conditions)]
+
     def min_det_F(self):
         """Smallest det F over the body."""
         return self.solid.min_det_F()

@@ -265,6 +265,11 @@ class Contact:
             return self.friction.with_friction(state)
         return state
 
+    def nodal_gap(self) -> np.ndarray:
+        """Owned nodal gaps at the current u (fresh search; length, >= 0 open)."""
+        self.refresh()
+        return self.surface.nodal(self._gap_form)
+
     def active_pattern(self) -> bytes:
         """This rank's active set as bytes: lam + r g < 0, or with friction the node pattern.
 

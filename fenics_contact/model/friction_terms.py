@@ -324,6 +324,10 @@ class CoulombFriction:
         self.contact.refresh()
         return np.column_stack([self.surface.nodal(f) for f in forms])
 
+    def nodal_slip(self) -> np.ndarray:
+        """Owned nodal slip increment dg_t since the last commit, shape (n, d-1) (length)."""
+        return self._nodal_components(self._slip_forms)
+
     def nodal_traction(self) -> np.ndarray:
         """Owned nodal tau = P(lam_t + r_t dg_t), shape (n, d-1) (stress)."""
         return self._nodal_components(self._tau_forms)

@@ -95,6 +95,7 @@ class ContactProblem(FrictionalContacts):
             self.potential -= external
         self._multiplier_is_pressure = True
         self._shared_nodes: int | None = None
+        self._hold = None  # the rigid-motion check of converged states, built when first asked
 
     # -- the first contact's objects ------------------------------------------------
     @property
@@ -407,6 +408,23 @@ class ContactProblem(FrictionalContacts):
     def min_det_F(self) -> DetFMinimum:
         """Smallest det F over the bodies (see :meth:`Solid.min_det_F`)."""
         return self.solid.min_det_F()
+
+    def unheld_motion(self, gap_tol: float) -> list[tuple[str, str]]:
+        """A rigid motion that the supports and the contacts closed in this state leave free.
+
+        (body name, its part of the motion in words) per moving body; [] when
+        every body is held. Closed: active or within ``gap_tol`` h of touching
+        (see :meth:`~.holding.ContactHold.in_state`). Collective; the bodies'
+        nodes are gathered on the first call. Not checked ([]) with
+        displacements of degree > 1 (the rigid modes are set at the vertices).
+        """
+        if self.solid.degree != 1:
+            return []
+        if self._hold is None:
+            from fenics_contact.model.holding import ContactHold
+
+            self._hold = ContactHold(self)
+        return self._hold.in_state(gap_tol)
 
     def target_force(self) -> fem.Function:
         """Force the first contact's striker puts on its target's vertices (pairs only)."""

@@ -11,6 +11,11 @@ what a Newton solve then meets.
 The check works on the Gram matrix M^T M (at most 6 x 6), summed over the
 MPI ranks, with coordinates centred on the body's bounding box and scaled by
 its size so that translations and rotations weigh alike.
+
+:class:`AssemblyModes` does the same for every body of a mesh at once and
+adds the contacts: the gaps closed at the start (before the run, unilateral)
+or the contact nodes closed in a deformed state (every converged iterate,
+both ways; :mod:`.holding` hands it a problem's contacts).
 """
 
 from __future__ import annotations
@@ -195,58 +200,143 @@ def free_assembly_motion(
         free motion found moves; empty when every rigid motion is held.
         Collective.
     """
-    gdim = domain.geometry.dim
-    tdim = domain.topology.dim
-    comm = domain.comm
-    x = domain.geometry.x[:, :gdim]
-    lo, hi = _reduce(comm, x, np.min, MPI.MIN), _reduce(comm, x, np.max, MPI.MAX)
-    centre = 0.5 * (lo + hi)
-    size = float(np.max(hi - lo)) or 1.0
-    n_modes = 3 if gdim == 2 else 6
-    n = n_modes * len(bodies)
-    gram = np.zeros((n, n))
-    vertices = []
-    for i, (_, cells) in enumerate(bodies):
-        verts = np.unique(mesh.entities_to_geometry(domain, tdim, cells.astype(np.int32)).ravel())
-        vertices.append(verts)
-        on_body = np.zeros(x.shape[0], bool)
-        on_body[verts] = True
-        for facets, value in conditions:
-            facets = np.asarray(facets, dtype=np.int32)
-            if facets.size == 0:
-                continue
-            fverts = np.unique(mesh.entities_to_geometry(domain, tdim - 1, facets).ravel())
-            points = (x[fverts[on_body[fverts]]] - centre) / size
-            for component, v in enumerate(value):
-                if v is not None and points.size:
-                    rows = np.zeros((points.shape[0], n))
-                    rows[:, i * n_modes:(i + 1) * n_modes] = _basis(points, component, gdim)
-                    gram += rows.T @ rows
-    total = np.empty_like(gram)
-    comm.Allreduce(gram, total, op=MPI.SUM)
-    eigenvalues, vectors = np.linalg.eigh(total)
-    free = vectors[:, eigenvalues <= 1e-10 * max(float(eigenvalues.max()), 1.0)]
-    if free.shape[1] == 0:
-        return []
-    # d gap / d mode at the closed nodes, for the modes the conditions leave free
-    step = 1e-7 * size
-    base = contact_gaps(np.zeros_like(x))
-    closed = base <= 1e-9 * size
-    columns = []
-    for j in range(free.shape[1]):
+    return AssemblyModes(domain, bodies, conditions).free_motion(contact_gaps,
+                                                                 tractions=tractions)
+
+
+class AssemblyModes:
+    """The rigid modes of each body of a mesh and the Dirichlet rows that hold them.
+
+    Built once (the bodies' nodes and the prescribed components at them);
+    :meth:`free_motion` then asks which motion the conditions and the
+    contacts leave free, at the start (unilateral closed gaps) or in a
+    deformed state (the contact nodes closed there, both ways). Collective.
+
+    Args:
+        domain: the mesh of every body.
+        bodies: (name, local cell indices) of each body.
+        conditions: (local facet indices, value per component, None free) of
+            each Dirichlet condition.
+    """
+
+    def __init__(
+        self,
+        domain: mesh.Mesh,
+        bodies: Sequence[tuple[str, np.ndarray]],
+        conditions: Sequence[tuple[np.ndarray, Sequence[float | None]]],
+    ) -> None:
+        tdim = domain.topology.dim
+        self.domain = domain
+        self.gdim = domain.geometry.dim
+        self.n_modes = 3 if self.gdim == 2 else 6
+        self.bodies = list(bodies)
+        self.vertices = [
+            np.unique(mesh.entities_to_geometry(domain, tdim, cells.astype(np.int32)).ravel())
+            for _, cells in self.bodies]
+        fverts = [np.unique(mesh.entities_to_geometry(
+            domain, tdim - 1, np.asarray(facets, dtype=np.int32)).ravel())
+            for facets, _ in conditions]
+        #: (body index, geometry nodes, component) of every prescribed component, body by body
+        self.held: list[tuple[int, np.ndarray, int]] = []
+        for i, verts in enumerate(self.vertices):
+            for nodes, (_, value) in zip(fverts, conditions, strict=True):
+                on_body = nodes[np.isin(nodes, verts)]
+                self.held += [(i, on_body, c) for c, v in enumerate(value)
+                              if v is not None and on_body.size]
+
+    def free_modes(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+        """The motions the conditions leave free at positions ``x`` (geometry nodes, length).
+
+        Returns (modes as columns, per body n_modes coefficients in scaled
+        coordinates; the centre and size of the scaling). Collective.
+        """
+        comm = self.domain.comm
+        lo, hi = _reduce(comm, x, np.min, MPI.MIN), _reduce(comm, x, np.max, MPI.MAX)
+        centre = 0.5 * (lo + hi)
+        size = float(np.max(hi - lo)) or 1.0
+        n = self.n_modes * len(self.bodies)
+        gram = np.zeros((n, n))
+        for i, nodes, component in self.held:
+            rows = np.zeros((nodes.size, n))
+            rows[:, i * self.n_modes:(i + 1) * self.n_modes] = _basis(
+                (x[nodes] - centre) / size, component, self.gdim)
+            gram += rows.T @ rows
+        total = np.empty_like(gram)
+        comm.Allreduce(gram, total, op=MPI.SUM)
+        eigenvalues, vectors = np.linalg.eigh(total)
+        free = vectors[:, eigenvalues <= 1e-10 * max(float(eigenvalues.max()), 1.0)]
+        return free, centre, size
+
+    def mode_field(self, x: np.ndarray, mode: np.ndarray, centre: np.ndarray,
+                   size: float) -> np.ndarray:
+        """The displacement of the geometry nodes by a scaled assembly mode (nodes, gdim)."""
         u = np.zeros_like(x)
-        for i in range(len(bodies)):
-            points = (x[vertices[i]] - centre) / size
-            mode = free[i * n_modes:(i + 1) * n_modes, j]
-            u[vertices[i]] += np.column_stack(
-                [_basis(points, c, gdim) @ mode for c in range(gdim)]) * step
-        columns.append((contact_gaps(u) - base)[closed] / step)
-    local = np.column_stack(columns) if columns else np.zeros((0, free.shape[1]))
-    resist = np.vstack(comm.allgather(local))
-    work = free.T @ _mode_loads(domain, vertices, tractions, centre, size, n_modes)
-    if np.any(work):
-        # the loads' work along a motion: a motion they oppose (negative work) is held
-        resist = np.vstack([resist, work / np.abs(work).max()])
+        for i, verts in enumerate(self.vertices):
+            points = (x[verts] - centre) / size
+            part = mode[i * self.n_modes:(i + 1) * self.n_modes]
+            u[verts] += np.column_stack(
+                [_basis(points, c, self.gdim) @ part for c in range(self.gdim)])
+        return u
+
+    def free_motion(
+        self,
+        contact_values: Callable[[np.ndarray], np.ndarray],
+        displacement: np.ndarray | None = None,
+        holding: Callable[[np.ndarray], np.ndarray] | None = None,
+        tractions: Sequence[tuple[np.ndarray, Sequence[float]]] = (),
+    ) -> list[tuple[str, str]]:
+        """A rigid motion that neither the conditions nor the contacts hold ([] when held).
+
+        Args:
+            contact_values: the owned nodal measures of every contact (joined:
+                gaps, and the slips of frictional ones, length) for a
+                displacement per geometry node, shape (nodes, gdim).
+            displacement: the state's displacement per geometry node (None: the
+                start, u = 0); the modes are rigid motions of the deformed
+                bodies and the measures change from their values there.
+            holding: None at the start: the gaps at most 1e-9 size are closed
+                and resist only the motions that close them (``contact_values``
+                gives gaps alone). In a state: called with the measures there
+                (only when the conditions leave a motion free) for the mask of
+                those that hold both ways, as the active set of a Newton step does.
+            tractions: (local facet indices, traction at load factor 1) of each
+                surface traction: at the start a motion they oppose is held.
+
+        Returns:
+            (body name, its part of the motion in words) per moving body. Collective.
+        """
+        x = self.domain.geometry.x[:, :self.gdim]
+        start = np.zeros_like(x) if displacement is None else displacement
+        x = x + start
+        free, centre, size = self.free_modes(x)
+        if free.shape[1] == 0:
+            return []
+        # d measure / d mode at the closed nodes, for the modes the conditions leave free
+        step = 1e-7 * size
+        base = contact_values(start)
+        closed = base <= 1e-9 * size if holding is None else holding(base)
+        columns = [(contact_values(start + step * self.mode_field(x, free[:, j], centre, size))
+                    - base)[closed] / step for j in range(free.shape[1])]
+        resist = np.vstack(self.domain.comm.allgather(np.column_stack(columns)))
+        if holding is not None:
+            if _full_rank(resist):
+                return []  # the closed nodes, held both ways, leave no mode free
+            resist = np.vstack([resist, -resist])  # a closed node resists both ways
+        work = free.T @ _mode_loads(self.domain, self.vertices, tractions, centre, size,
+                                    self.n_modes) if tractions else np.zeros(0)
+        if np.any(work):
+            # the loads' work along a motion: a motion they oppose (negative work) is held
+            resist = np.vstack([resist, work / np.abs(work).max()])
+        return _name_free_motion(free, resist, self.bodies, centre, size, self.gdim)
+
+
+def _name_free_motion(free: np.ndarray, resist: np.ndarray,
+                      bodies: Sequence[tuple[str, np.ndarray]], centre: np.ndarray,
+                      size: float, gdim: int) -> list[tuple[str, str]]:
+    """The free motion among the columns of ``free`` that ``resist`` (c >= 0) allows, in words.
+
+    The single free modes first, then what else is free; [] when none.
+    """
     pure, coefficients = _pure_free_modes(free, resist, bodies, centre, gdim)
     if pure:
         # what else is free, apart from the pure modes (a rotation about another point)
@@ -259,6 +349,21 @@ def free_assembly_motion(
         return pure
     c = _lp_free_motion(resist, free.shape[1])
     return [] if c is None else _moving_bodies(free @ c, bodies, centre, size, gdim)
+
+
+def _full_rank(resist: np.ndarray) -> bool:
+    """Whether two-sided rows leave no combination c that :func:`_lp_free_motion` finds.
+
+    Such a c has |resist c| <= 1e-9 per row and max |c| > 1e-3, so
+    |resist c|_2 <= 1e-9 sqrt(rows) while |resist c|_2 >= s_min 1e-3: a
+    smallest singular value above 1e-6 sqrt(rows) rules it out (and every
+    pure mode, max |c| = 1) without the linear programs, the common case of
+    a held body, at a fraction of their cost.
+    """
+    m, k = resist.shape
+    if m < k:
+        return False
+    return bool(np.linalg.svd(resist, compute_uv=False)[-1] > 1e-6 * np.sqrt(m))
 
 
 def _mode_loads(domain: mesh.Mesh, vertices: list[np.ndarray],

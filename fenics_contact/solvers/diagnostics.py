@@ -18,7 +18,12 @@ Statuses, with their defined tests (checked in this order each iteration):
   the Dirichlet rows of the residual hold x - x_D in length units, so at a
   large r, whose round-off floor raises the tolerance, the residual before
   the first Newton step of a displacement-driven step could pass the test
-  with the load not applied.
+  with the load not applied. Finally every body must be held
+  (:func:`hold_admissibility`): a rigid motion that no support holds and
+  that moves no contact node closed in the iterate (active, or touching
+  within ``gap_tol`` h) leaves the stiffness singular, and the "solution"
+  is an arbitrary rigid motion (SUA at r = 1e-3 threw a stack 6 lengths
+  clean through the ball pressing it, every contact open, and converged).
 - ``cycling``: over the last ``cycle_window`` iterations the residual never
   fell below the smallest value seen before that window, and the active set
   (or, without one, the rounded residual) returned to a state it had left
@@ -397,6 +402,29 @@ def prescribed_admissibility(
     return check
 
 
+def hold_admissibility(problem, settings: SolverSettings) -> Callable[[], str | None]:
+    """Every body of a converged iterate is held by its supports or its closed contacts.
+
+    Returns a callable giving None when each rigid motion of each body is
+    held by a prescribed component or moves some contact node closed in the
+    iterate (active, or with a gap at most ``settings.gap_tol * h``; see
+    :meth:`~fenics_contact.model.problem.ContactProblem.unheld_motion`),
+    else a sentence naming the bodies and the motion. Cheap when the
+    supports alone hold every body (no contact is evaluated).
+    """
+
+    def check() -> str | None:
+        moving = problem.unheld_motion(settings.gap_tol)
+        if not moving:
+            return None
+        what = "; ".join(f"body {name!r}: {motion}" for name, motion in moving)
+        return (f"a rigid motion is held by nothing ({what}): no support holds it and no "
+                "contact is closed against it in this state, so the stiffness is singular "
+                "and the iterate is one of a family of rigid positions")
+
+    return check
+
+
 Check = Callable[[], str | None]
 
 
@@ -431,9 +459,11 @@ def admissibility(
     """What a converged iterate must satisfy beside the residual test.
 
     The prescribed displacements, then (when the strategy enforces the
-    constraint exactly, i.e. not penalty) the Signorini and Coulomb tests.
+    constraint exactly, i.e. not penalty) the Signorini and Coulomb tests,
+    then (every strategy) that supports or closed contacts hold every body.
     """
     return all_of(
         prescribed_admissibility(problem, settings),
         contact_admissibility(problem, settings) if exact_constraint else None,
+        hold_admissibility(problem, settings),
     )

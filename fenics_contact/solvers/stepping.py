@@ -283,7 +283,13 @@ def _settle(strategy: Strategy, t: float) -> None:
         kernel.assemble_residual()
 
 
-def _failure_message(record: StepRecord, t_try: float, refused: str | None = None) -> str:
+def _failure_message(record: StepRecord, t_try: float, refused: str | None = None,
+                     earlier: tuple[int, str] | None = None) -> str:
+    """Why a step failed, in words.
+
+    ``refused``: the last attempt's refusal; ``earlier``: (attempt number,
+    reason) of an earlier attempt's, named when the last one was not refused.
+    """
     if record.status == Status.INVERTED:
         x = ", ".join(f"{c:.4g}" for c in record.worst_cell)
         return (
@@ -306,6 +312,9 @@ def _failure_message(record: StepRecord, t_try: float, refused: str | None = Non
                     "derivative there), which smaller steps do not change")
     if refused:
         message += f"; the residual met its tolerance but the iterate was refused: {refused}"
+    elif earlier is not None:
+        message += (f"; in attempt {earlier[0]} the residual met its tolerance but the "
+                    f"iterate was refused: {earlier[1]}")
     return message
 
 
@@ -372,7 +381,8 @@ def solve_load_path(
         step = StepRecord(step=k, load_factor=target, status=Status.CONVERGED.value)
         start = time.perf_counter()
         increment = target - t
-        halvings = 0
+        halvings = attempts = 0
+        earlier: tuple[int, str] | None = None  # the last refusal of an attempt of this step
         smallest = increment / 2**max_cutbacks
         while t < target - 1e-14:
             t_try = min(t + increment, target)
@@ -382,6 +392,7 @@ def solve_load_path(
             saved = problem.snapshot()
             problem.set_load(t_try)
             result = strategy.solve()
+            attempts += 1
             _absorb(step, result, run)
             if on_iteration is not None:
                 on_iteration(step, result)
@@ -395,6 +406,8 @@ def solve_load_path(
                     continue
                 status = Status.INVERTED
             refused = refusal(strategy, result) if status is not Status.INVERTED else None
+            if refused is not None:
+                earlier = (attempts, refused)
             problem.restore(saved)
             if status is not Status.INVERTED:  # the record holds the state the run stops in
                 det = problem.min_det_F()
@@ -403,7 +416,7 @@ def solve_load_path(
             if halvings > max_cutbacks or increment / 2 < smallest * (1 - 1e-12):
                 step.status = status.value
                 step.load_factor = t
-                step.message = _failure_message(step, t_try, refused)
+                step.message = _failure_message(step, t_try, refused, earlier)
                 _settle(strategy, t)
                 break
             increment /= 2
