@@ -426,6 +426,17 @@ class ContactProblem(FrictionalContacts):
             self._hold = ContactHold(self)
         return self._hold.in_state(gap_tol)
 
+    def balls_passed_through(self) -> list[str]:
+        """The contacts whose rigid ball has its centre inside the deformed body (collective).
+
+        See :mod:`.passage`; [] with displacements of degree > 1.
+        """
+        if self.solid.degree != 1:
+            return []
+        from fenics_contact.model.passage import balls_passed_through
+
+        return balls_passed_through(self.V, self.u, self.contacts)
+
     def target_force(self) -> fem.Function:
         """Force the first contact's striker puts on its target's vertices (pairs only)."""
         return self.contact.target_force()

@@ -425,6 +425,29 @@ def hold_admissibility(problem, settings: SolverSettings) -> Callable[[], str | 
     return check
 
 
+def passage_admissibility(problem) -> Callable[[], str | None] | None:
+    """No rigid ball of a converged iterate has its centre inside the body.
+
+    A ball's gap is positive on both sides of it: a step that carries a
+    body across a small ball ends with every gap open (see
+    :meth:`~fenics_contact.model.problem.ContactProblem.balls_passed_through`).
+    None when the problem has no such check.
+    """
+    find = getattr(problem, "balls_passed_through", None)
+    if find is None:
+        return None
+
+    def check() -> str | None:
+        names = find()
+        if not names:
+            return None
+        return (f"the body has passed through rigid obstacle(s) {', '.join(map(repr, names))}: "
+                "the ball's centre lies inside the deformed body, its gaps read open on the "
+                "far side; the step carried the surface across it (smaller load steps)")
+
+    return check
+
+
 Check = Callable[[], str | None]
 
 
@@ -465,5 +488,6 @@ def admissibility(
     return all_of(
         prescribed_admissibility(problem, settings),
         contact_admissibility(problem, settings) if exact_constraint else None,
+        passage_admissibility(problem),
         hold_admissibility(problem, settings),
     )
