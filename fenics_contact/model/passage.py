@@ -12,10 +12,11 @@ thin body and came out leaves no trace; the gaps then see the far side).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 
 import numpy as np
-from dolfinx import fem, geometry
+from dolfinx import fem, geometry, mesh
 
 from mpi4py import MPI
 
@@ -29,7 +30,19 @@ def deformed_vertices(V: fem.FunctionSpace, u: fem.Function) -> np.ndarray:
     geo = domain.geometry.dofmaps[0]
     blocks = np.zeros(domain.geometry.x.shape[0], np.int64)
     blocks[geo.ravel()] = V.dofmap.list[:, :geo.shape[1]].ravel()  # vertex dofs first
+    u.x.scatter_forward()
     return domain.geometry.x[:, :gdim] + u.x.array.reshape(-1, gdim)[blocks]
+
+
+@contextmanager
+def placed(domain: mesh.Mesh, x: np.ndarray) -> Iterator[None]:
+    """Temporarily give the mesh geometry the positions ``x`` (restored on exit)."""
+    saved = domain.geometry.x.copy()
+    try:
+        domain.geometry.x[:, :x.shape[1]] = x
+        yield
+    finally:
+        domain.geometry.x[:] = saved
 
 
 def points_inside(V: fem.FunctionSpace, u: fem.Function, points: np.ndarray) -> np.ndarray:
@@ -41,9 +54,7 @@ def points_inside(V: fem.FunctionSpace, u: fem.Function, points: np.ndarray) -> 
     lo, hi = x.min(axis=0, initial=np.inf), x.max(axis=0, initial=-np.inf)
     near = np.all((points >= lo) & (points <= hi), axis=1) if x.size else found
     if np.any(near):
-        saved = domain.geometry.x.copy()
-        try:
-            domain.geometry.x[:, :gdim] = x
+        with placed(domain, x):
             tree = geometry.bb_tree(domain, tdim)
             query = np.zeros((int(near.sum()), 3))
             query[:, :gdim] = points[near]
@@ -51,8 +62,6 @@ def points_inside(V: fem.FunctionSpace, u: fem.Function, points: np.ndarray) -> 
                 domain, geometry.compute_collisions_points(tree, query), query)
             found[np.flatnonzero(near)] = [len(colliding.links(i)) > 0
                                           for i in range(query.shape[0])]
-        finally:
-            domain.geometry.x[:] = saved
     mine = found.astype(np.int32)
     every = np.empty_like(mine)
     domain.comm.Allreduce(mine, every, op=MPI.MAX)
@@ -71,4 +80,4 @@ def balls_passed_through(V: fem.FunctionSpace, u: fem.Function,
     return [name for (name, _), hit in zip(balls, inside, strict=True) if hit]
 
 
-__all__ = ["balls_passed_through", "deformed_vertices", "points_inside"]
+__all__ = ["balls_passed_through", "deformed_vertices", "placed", "points_inside"]

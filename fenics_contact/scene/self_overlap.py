@@ -25,8 +25,6 @@ without such a pair, the mean size of the body's exterior facets.
 from __future__ import annotations
 
 import warnings
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -37,6 +35,7 @@ from mpi4py import MPI
 
 from fenics_contact.model.automatic_pairing import mean_facet_size
 from fenics_contact.model.mortar import MortarContact
+from fenics_contact.model.passage import deformed_vertices, placed
 from fenics_contact.model.search import project
 from fenics_contact.scene.body_overlap import WARN_DEPTH, WARN_DEPTH_MORTAR
 
@@ -106,28 +105,6 @@ class Overlap:
     wall_roles: int
 
 
-def deformed_nodes(problem: ContactProblem) -> np.ndarray:
-    """(n, gdim) current positions of the mesh's local geometry nodes (length)."""
-    domain, V, u = problem.domain, problem.V, problem.u
-    gdim = domain.geometry.dim
-    geo = domain.geometry.dofmaps[0]
-    blocks = np.zeros(domain.geometry.x.shape[0], np.int64)
-    blocks[geo.ravel()] = V.dofmap.list[:, :geo.shape[1]].ravel()  # vertex dofs come first
-    u.x.scatter_forward()
-    return domain.geometry.x[:, :gdim] + u.x.array.reshape(-1, gdim)[blocks]
-
-
-@contextmanager
-def placed(domain: mesh.Mesh, x: np.ndarray) -> Iterator[None]:
-    """Temporarily give the mesh geometry the positions ``x`` (restored on exit)."""
-    saved = domain.geometry.x.copy()
-    try:
-        domain.geometry.x[:, :x.shape[1]] = x
-        yield
-    finally:
-        domain.geometry.x[:] = saved
-
-
 def body_cells(problem: ContactProblem, body: Body) -> np.ndarray:
     """The body's owned cells (every owned cell for a one-body mesh)."""
     tdim = problem.domain.topology.dim
@@ -184,7 +161,8 @@ def gathered_surface(problem: ContactProblem, cells: np.ndarray, x: np.ndarray,
                      pairs: list) -> Surface:
     """The exterior surface of the body made of ``cells``, on every rank (collective).
 
-    ``x``: :func:`deformed_nodes`; ``pairs``: the body's self-contact pairs.
+    ``x``: :func:`~fenics_contact.model.passage.deformed_vertices`; ``pairs``: the
+    body's self-contact pairs.
     """
     domain, comm = problem.domain, problem.comm
     fdim, gdim = domain.topology.dim - 1, domain.geometry.dim
@@ -285,7 +263,7 @@ def self_overlap(problem: ContactProblem, body: Body, pairs: list, tolerance: fl
     facets (the collision test's unit).
     """
     comm = problem.comm
-    x = deformed_nodes(problem)
+    x = deformed_vertices(problem.V, problem.u)
     cells = body_cells(problem, body)
     surface = gathered_surface(problem, cells, x, pairs)
     if surface.ids.size == 0:
