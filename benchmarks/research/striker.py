@@ -313,6 +313,10 @@ class StrikerOnFacetProblem:
         """Largest |u - u_D| over the prescribed components (length, global)."""
         return self.solid.prescribed_mismatch()
 
+    def balls_passed_through(self) -> list[str]:
+        """No rigid ball here: [] (see ContactProblem.balls_passed_through)."""
+        return []
+
     def unheld_motion(self, gap_tol: float) -> list[tuple[str, str]]:
         """A rigid motion of the body that its supports leave free ([] when they hold it).
 

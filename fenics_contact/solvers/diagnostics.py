@@ -425,20 +425,16 @@ def hold_admissibility(problem, settings: SolverSettings) -> Callable[[], str | 
     return check
 
 
-def passage_admissibility(problem) -> Callable[[], str | None] | None:
+def passage_admissibility(problem) -> Callable[[], str | None]:
     """No rigid ball of a converged iterate has its centre inside the body.
 
     A ball's gap is positive on both sides of it: a step that carries a
     body across a small ball ends with every gap open (see
     :meth:`~fenics_contact.model.problem.ContactProblem.balls_passed_through`).
-    None when the problem has no such check.
     """
-    find = getattr(problem, "balls_passed_through", None)
-    if find is None:
-        return None
 
     def check() -> str | None:
-        names = find()
+        names = problem.balls_passed_through()
         if not names:
             return None
         return (f"the body has passed through rigid obstacle(s) {', '.join(map(repr, names))}: "
