@@ -32,6 +32,7 @@ from fenics_contact.scene.pressure_scatter import warn_pressure_scatter
 from fenics_contact.scene.schema import Scene
 from fenics_contact.scene.self_overlap import warn_self_overlap
 from fenics_contact.scene.striker_advice import advise_striker
+from fenics_contact.scene.unpaired_overlap import warn_unpaired_overlap
 from fenics_contact.solvers import make_strategy
 from fenics_contact.solvers.base import SolveResult
 from fenics_contact.solvers.linear import LinearSolverSettings
@@ -366,6 +367,7 @@ def run_scene(
         warn_untagged_penetration(scene, problem)
         warn_body_overlap(scene, problem, watch)
         warn_self_overlap(scene, problem)
+        warn_unpaired_overlap(scene, problem)
         advise_striker(scene, problem)
         warn_pressure_scatter(scene, problem)
     summary = _write_summary(comm, out, scene, path, used, notes)

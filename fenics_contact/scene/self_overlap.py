@@ -116,7 +116,7 @@ def body_cells(problem: ContactProblem, body: Body) -> np.ndarray:
     return cells[cells < owned].astype(np.int32)
 
 
-def _exterior_facets(domain: mesh.Mesh, cells: np.ndarray) -> np.ndarray:
+def exterior_facets(domain: mesh.Mesh, cells: np.ndarray) -> np.ndarray:
     """Owned exterior facets of the mesh whose cell is one of ``cells``."""
     tdim = domain.topology.dim
     domain.topology.create_connectivity(tdim - 1, tdim)
@@ -166,7 +166,7 @@ def gathered_surface(problem: ContactProblem, cells: np.ndarray, x: np.ndarray,
     """
     domain, comm = problem.domain, problem.comm
     fdim, gdim = domain.topology.dim - 1, domain.geometry.dim
-    facets = _exterior_facets(domain, cells)
+    facets = exterior_facets(domain, cells)
     nodes = mesh.entities_to_geometry(domain, fdim, facets)
     nv = nodes.shape[1] if facets.size else {2: 2, 3: 3}[gdim]
     nodes = nodes.reshape(-1, nv)
@@ -210,12 +210,13 @@ def nodes_inside(problem: ContactProblem, cells: np.ndarray, x: np.ndarray,
     return np.unique(owner[foreign])
 
 
-def depths(points: np.ndarray, node_ids: np.ndarray, surface: Surface
-           ) -> tuple[np.ndarray, np.ndarray]:
-    """(depth, facet) of each node inside its body: its distance to the nearest wall (length).
+def depths(points: np.ndarray, node_ids: np.ndarray, surface: Surface,
+           normals: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """(depth, facet) of each node inside a body: its distance to the nearest wall (length).
 
-    The wall: the exterior facets that do not contain the node and face it
-    (their outward normal against the node's, :meth:`Surface.node_normals`).
+    The wall: the exterior facets of ``surface`` that do not contain the node
+    and face it (their outward normal against the node's: ``normals``, by
+    default :meth:`Surface.node_normals`, the node being on ``surface``).
     A facet facing the node's way is not a wall it entered: in a slab held
     in plane strain every node lies in the plane of an end face, and on a
     symmetry cut in that of the cut, at distance 0. 0 where no facet faces it.
@@ -229,7 +230,7 @@ def depths(points: np.ndarray, node_ids: np.ndarray, surface: Surface
     k = min(CANDIDATES, tri.shape[0])
     reach, idx = tree.query(points, k=k)
     reach, idx = reach.reshape(len(points), -1), idx.reshape(len(points), -1)
-    normals = surface.node_normals(node_ids)
+    normals = surface.node_normals(node_ids) if normals is None else normals
     dist, wall = _nearest_wall(points, node_ids, normals, surface, idx)
     redo = np.flatnonzero(reach[:, -1] <= dist + radius) if k < tri.shape[0] else []
     for i in redo:  # a nearer facet may lie past the k nearest centroids
@@ -355,7 +356,7 @@ def warn_self_overlap(scene: Scene, problem: ContactProblem) -> float:
     for body in problem.solid.bodies:
         pairs = _self_pairs(problem, body)
         cells = body_cells(problem, body)
-        size = mean_facet_size(problem.domain, _exterior_facets(problem.domain, cells))
+        size = mean_facet_size(problem.domain, exterior_facets(problem.domain, cells))
         if not np.isfinite(size):
             continue
         h = min((c.surface.h for c in pairs), default=size)
