@@ -2,8 +2,7 @@
 
 The shipped sphere on a block (coarser hemisphere striking) gets none; the
 same scene with the roles swapped (the finer block striking) is told to swap
-them back. Node-to-segment is told the opposite on the two cylinders whose
-coarser arc strikes.
+them back. Node-to-segment gets no advice, its coarser arc striking or not.
 """
 
 from __future__ import annotations
@@ -52,16 +51,24 @@ def test_mortar_3d_is_told_to_strike_with_the_coarser_surface(swap):
         assert advice == []
 
 
-def test_node_to_segment_is_told_to_strike_with_the_finer_surface():
-    from fenics_contact.scene.checks import SceneWarning
+def test_node_to_segment_gets_no_striker_advice_either_way():
+    """No size rule holds for node-to-segment: none is given.
 
-    scene, problem = _solved("two_cylinders_node_to_segment.toml", True, h_contact=0.02)
-    with pytest.warns(SceneWarning, match="finer surface striking"):
-        advice = advise_striker(scene, problem)
-    assert len(advice) == 1 and "ratio 1.3" in advice[0]  # the target's arc is 1.37 h
-    scene, problem = _solved("two_cylinders_node_to_segment.toml", False, h_contact=0.02)
-    assert advise_striker(scene, problem) == []
-
+    The equal cylinders' interior error doubles with the coarser arc
+    striking; a user's dissimilar cylinders (R 0.8 / 1.6, E 300 / 100) halve
+    it the same way (L2 inside 0.8 a: 2.5 % against 5.5 %), and a user's
+    shrink fit, told to let the finer disk strike, scattered 31 % against
+    5.4 %. Before, the coarser striker was told to swap.
+    """
+    for swap in (True, False):
+        scene, problem = _solved("two_cylinders_node_to_segment.toml", swap, h_contact=0.02)
+        sizes = touching_sizes(problem, problem.contacts[0])
+        if swap:  # the coarser arc strikes: its target's arc is 1.37 h
+            assert sizes.striker > 1.25 * sizes.target
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            assert advise_striker(scene, problem) == []
+        assert not any("swap striker and target" in str(w.message) for w in caught)
 
 
 def test_the_rim_of_a_striker_in_contact_is_seen_and_symmetry_cuts_are_no_rim():

@@ -1,11 +1,16 @@
 """After a run: whether each two-body pair strikes with the surface its discretisation prefers.
 
-The striker carries one multiplier per node. A mortar pair striking with the
-finer surface over-determines the coarser target and its nodal pressures
-scatter about twice as much (``benchmarks/validation/striker_choice.py``);
-node-to-segment prefers the finer surface striking. The facet sizes compared
-are those where the pair touches at the end of the run: the striker facets
-with a node in contact, and the target facets within reach of them.
+The striker carries one multiplier per node. A 3D mortar pair striking with
+the finer surface over-determines the coarser target and its nodal pressures
+scatter about twice as much (``benchmarks/validation/striker_choice.py``).
+Node-to-segment follows no rule that holds across cases (the finer surface
+striking halved the interior error of two equal cylinders and doubled it on
+dissimilar ones, and made a shrink fit's pressures scatter six times more):
+it gets no advice here; a target node that ends inside its striker is named
+by :mod:`.body_overlap`, and pressures that scatter by
+:mod:`.pressure_scatter`. The facet sizes compared are those where the pair
+touches at the end of the run: the striker facets with a node in contact,
+and the target facets within reach of them.
 """
 
 from __future__ import annotations
@@ -21,7 +26,6 @@ from scipy.spatial import cKDTree
 from mpi4py import MPI
 
 from fenics_contact.model.mortar import MortarContact
-from fenics_contact.model.pairs import NodeToSegmentContact
 from fenics_contact.model.segments import node_blocks
 
 if TYPE_CHECKING:
@@ -159,31 +163,25 @@ def advise_striker(scene: Scene, problem: ContactProblem) -> list[str]:
     resolves its edge with fewer nodes: no advice), unless the striker's rim
     is in contact: swapped, the coarser surface would overhang the finer
     one's rim, which a frictional block dragged on a larger block did not
-    survive (it cycled, where the given striker converges). Node-to-segment: coarser
-    than the target's by as much. Self-contact pairs have one surface and get
-    none. Collective.
+    survive (it cycled, where the given striker converges). Node-to-segment
+    pairs get none (see the module's description), nor do self-contact
+    pairs, which have one surface. Collective.
     """
     from fenics_contact.scene.checks import SceneWarning
 
     advice = []
     for contact in problem.contacts:
-        mortar = isinstance(contact, MortarContact)
-        if not (mortar or isinstance(contact, NodeToSegmentContact)) \
+        if not isinstance(contact, MortarContact) or problem.domain.geometry.dim != 3 \
                 or getattr(contact, "self_contact", False):
             continue
         sizes = touching_sizes(problem, contact)
         if sizes is None:
             continue
         ratio = sizes.striker / sizes.target
-        if mortar and problem.domain.geometry.dim == 3 and ratio < RATIO:
-            if rim_in_contact(problem, contact, sizes.striker):
-                continue  # swapped, the striker would overhang its target's rim there
-            why = ("a mortar pair's nodal pressures are smoother with the coarser surface "
-                   "striking (about half the scatter)")
-        elif not mortar and ratio > 1.0 / RATIO:
-            why = "node-to-segment is more accurate with the finer surface striking"
-        else:
-            continue
+        if ratio >= RATIO or rim_in_contact(problem, contact, sizes.striker):
+            continue  # swapped at its rim, the striker would overhang its target's rim there
+        why = ("a mortar pair's nodal pressures are smoother with the coarser surface "
+               "striking (about half the scatter)")
         text = (f"{scene.path.name}: [[pair]] {contact.name!r}: where it touches, the striker's "
                 f"facets are {sizes.striker:.3g} and the target's {sizes.target:.3g} "
                 f"(ratio {ratio:.2f}); {why}: swap striker and target "

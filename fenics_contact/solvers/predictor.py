@@ -27,6 +27,8 @@ At the first step, from rest, the nodes that touch (g = 0) start in
 contact instead of none. The choice is imposed through the multiplier
 (lam + r g just below zero for a node set in contact, at or above zero for a
 node set open), so it holds for every r; it is again only a starting guess.
+The penalty method, whose multiplier is not an unknown and stays zero, gets
+the extrapolated displacement only.
 """
 
 from __future__ import annotations
@@ -123,7 +125,8 @@ class Extrapolated:
         s = (self.problem.load_factor - t1) / (t1 - t0)
         u, _ = self._state()
         u[:] = u1 + s * (u1 - u0)
-        self._set_multipliers(lam1 + s * (lam1 - lam0))
+        if self.problem.multiplier_is_pressure:  # the penalty method's lam stays zero
+            self._set_multipliers(lam1 + s * (lam1 - lam0))
         if self.problem.min_det_F().value <= 0.0:
             # the extrapolation turns an element inside out (a fold closing): start from
             # the last converged state instead, whose elements are all admissible
@@ -164,7 +167,14 @@ class ActiveSetPredicted(Extrapolated):
         super().__init__(strategy)
 
     def _chosen(self) -> list:
-        """The contacts whose set the predictor chooses."""
+        """The contacts whose set the predictor chooses (none under the penalty method).
+
+        The choice is imposed through lam, which the penalty method does not
+        solve for: its lam must stay zero, or lam + r g, the pressure it
+        reports, would be shifted by the imposed value.
+        """
+        if not self.problem.multiplier_is_pressure:
+            return []
         return [c for c in self.problem.contacts
                 if c.friction is None and c.settings.quadrature == "nodal"]
 
