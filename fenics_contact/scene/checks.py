@@ -222,8 +222,10 @@ def warn_untagged_penetration(scene: Scene, problem: ContactProblem) -> int:
     Only the tagged facets are held by an obstacle; a face left out of the
     tag (a side that folds over under large compression, a corner that
     rolls) passes through it unnoticed, and the answer is wrong without a
-    failure. Checked on the current state (the end of a run); returns the
-    number of such nodes (collective).
+    failure. A node counts when it lies deeper than 1e-3 h and, under the
+    penalty method, than the deepest tagged node (the method's own
+    penetration carries the nodes beside the tagged ones in too). Checked on the current state (the
+    end of a run); returns the number of such nodes (collective).
     """
     from dolfinx import fem
 
@@ -259,7 +261,14 @@ def warn_untagged_penetration(scene: Scene, problem: ContactProblem) -> int:
         others = np.setdiff1d(on_boundary, tagged)
         others = others[others < owned]
         depth = -contact.obstacle.gap_value(x[others]) if others.size else np.zeros(0)
-        inside = depth > 1e-3 * contact.surface.h
+        own = 0.0
+        if not problem.multiplier_is_pressure:
+            # the penalty method's own penetration: no deeper than the tagged nodes themselves
+            held = tagged[tagged < owned]
+            own = float(np.max(-contact.obstacle.gap_value(x[held]), initial=0.0)) \
+                if held.size else 0.0
+            own = problem.comm.allreduce(own, op=MPI.MAX)
+        inside = depth > max(1e-3 * contact.surface.h, own)
         count = problem.comm.allreduce(int(np.sum(inside)), op=MPI.SUM)
         if count == 0:
             continue
