@@ -697,6 +697,28 @@ def test_shallow_initial_overlap_is_reported_and_runs(tmp_path):
         _build(_overlapping(tmp_path, 0.01))
 
 
+def test_a_run_that_finishes_no_step_does_not_check_its_start_as_an_answer(tmp_path):
+    """Bodies that start inside each other, and a first step that fails (NUA, 3 iterations).
+
+    The start is reported before the first step; the end-of-run checks
+    describe an answer and there is none: before, the overlap of the start
+    was named again as "a boundary node ... lies inside", with the advice
+    to refine or retag, which does not apply.
+    """
+    from fenics_contact import run_scene
+    from fenics_contact.scene.checks import SceneWarning
+
+    path = _overlapping(tmp_path, 0.05)
+    path.write_text(path.read_text().replace(
+        'method = "gnrm"', 'method = "nua"\nmax_iterations = 3\nmax_cutbacks = 1'))
+    with pytest.warns(SceneWarning, match="start 0.05 .* inside each other"):
+        outcome = run_scene(load_scene(path), tmp_path / "run", pictures=False)
+    assert not outcome.path.converged
+    assert not any(s["status"] == "converged" for s in outcome.summary["steps"])
+    assert len(outcome.summary["warnings"]) == 1
+    assert "inside each other" in outcome.summary["warnings"][0]
+
+
 @pytest.mark.parametrize("nu", [0.48, 0.49, 0.4999])
 def test_near_incompressible_linear_elements_are_warned_about(tmp_path, nu):
     """From nu = 0.48 on P1 elements lock: built, with a warning naming the effect and the fix.
