@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 
 from fenics_contact import run_scene
+from fenics_contact.scene.checks import SceneWarning
 from fenics_contact.scene.schema import scene_from_data
 
 SCENES = Path(__file__).parents[1] / "scenes"
@@ -58,8 +59,10 @@ def test_penalty_on_a_body_that_starts_inside_a_floor_reports_the_reaction(tmp_p
         "dirichlet": [{"tag": "top", "value": [0.0, 0.0]}],
         "solver": {"method": "penalty", "steps": 1},
     }
-    outcome = run_scene(scene_from_data(data, tmp_path / "block.toml"), tmp_path / "run",
-                        pictures=False)
+    with pytest.warns(SceneWarning, match=r"the body starts 0.01 \(0.2 h\) inside the "
+                      r"obstacle; the first load step pushes it out"):
+        outcome = run_scene(scene_from_data(data, tmp_path / "block.toml"), tmp_path / "run",
+                            pictures=False)
     assert outcome.path.converged
     (force, reaction), = _balance(outcome.summary)
     assert reaction > 4.0  # the floor pushes the block 0.01 up against its clamped top

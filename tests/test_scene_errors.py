@@ -426,7 +426,12 @@ def test_initial_penetration_beyond_facet_size_warns(tmp_path):
     with pytest.warns(SceneWarning, match=r"starts 0.6 inside the obstacle, more than the "
                       r"contact facet size h = 0.25 \(2.4 h\)"):
         _build(write(tmp_path, scene))
-    scene["obstacle"]["point"] = [0.0, 0.2]  # 0.2 < h: no warning
+    scene["obstacle"]["point"] = [0.0, 0.2]  # 0.2 < h: pushed out by the first step
+    with pytest.warns(SceneWarning, match=r"starts 0.2 \(0.8 h\) inside the obstacle; the "
+                      r"first load step pushes it out") as seen:
+        _build(write(tmp_path, scene))
+    assert not any("more than the contact facet size" in str(w.message) for w in seen)
+    scene["obstacle"]["point"] = [0.0, 0.0]  # touching: no warning
     with warnings.catch_warnings():
         warnings.simplefilter("error", SceneWarning)
         _build(write(tmp_path, scene))

@@ -165,6 +165,25 @@ def test_geo_parameter_in_the_plain_form_is_named_with_the_form_to_use(tmp_path,
                      err), err
 
 
+def test_a_geo_parameter_under_another_onelab_path_is_named(tmp_path):
+    """h = {0.1, Name "P/h"}: gmsh reads it, a scene cannot set it; the message says why."""
+    from fenics_contact.scene.build import build_mesh
+    from fenics_contact.scene.schema import SceneError, load_scene
+
+    shipped = Path(__file__).parents[1] / "scenes" / "hertz_cylinder.toml"
+    geo = (shipped.parents[1] / "meshes" / "hertz_cylinder.geo").read_text()
+    moved = geo.replace('Name "Parameters/', 'Name "P/')
+    assert moved != geo
+    (tmp_path / "moved.geo").write_text(moved)
+    scene_file = tmp_path / "moved.toml"
+    scene_file.write_text(shipped.read_text().replace('"../meshes/hertz_cylinder.geo"',
+                                                      f'"{tmp_path}/moved.geo"'))
+    with pytest.raises(SceneError, match=r"'h_contact' is declared with Name 'P/h_contact'; "
+                       r"only names under \"Parameters/\" can be set from a scene: Name "
+                       r"\"Parameters/h_contact\""):
+        build_mesh(load_scene(scene_file))
+
+
 def test_dirichlet_path_drives_a_one_body_scene(tmp_path):
     """A [[dirichlet]] path is followed knot by knot, not ramped to its end value."""
     import numpy as np

@@ -89,14 +89,23 @@ class ContactSettings:
             'gauss' integrates the contact term with a degree-4 Gauss rule on
             each facet (an integral constraint whose answer depends a little
             on r; needed with quadratic displacements).
+        interference_until: the load factor by which an overlap the surfaces
+            start in (an interference fit meshed as it is before assembly) is
+            resolved: each striker node's starting overlap is allowed, less
+            and less in proportion to the load factor, until then. None (the
+            default): the first load step resolves it at once.
     """
 
     r: float = 1.0
     relative: bool = True
     quadrature: Quadrature = "nodal"
+    interference_until: float | None = None
 
     def __post_init__(self) -> None:
         check_r(self.r)
+        t = self.interference_until
+        if t is not None and not 0.0 < t <= 1.0:
+            raise ValueError(f"interference_until must be a load factor in (0, 1], got {t}.")
         if self.quadrature not in ("nodal", "gauss"):
             raise ValueError(
                 f"Contact quadrature {self.quadrature!r} is unknown; use 'nodal' or 'gauss'."

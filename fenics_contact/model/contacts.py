@@ -106,6 +106,13 @@ class Contact:
         self.r = fem.Constant(self.domain, default_scalar_type(1.0))
         self.surface.jit_options = self.jit_options
         self.gap = self._bind_partner(solid)
+        #: Each striker node's starting overlap (length, >= 0), allowed times
+        #: :attr:`allowance` (1 at load factor 0, 0 from ``interference_until`` on).
+        self.interference: fem.Function | None = None
+        self.allowance = fem.Constant(self.domain, default_scalar_type(0.0))
+        if self.settings.interference_until is not None:
+            self.interference = fem.Function(self.Q, name="interference")
+            self.gap = self.gap + self.allowance * self.interference
         self.set_r(self.settings.r, relative=self.settings.relative)
         self.pressure = augmented_pressure(self.gap, self.lam, self.r)
         if self.normal_mask is not None:
@@ -146,6 +153,39 @@ class Contact:
 
     def set_load(self, t: float) -> None:
         """Move the partner to load factor t (a moving obstacle); nothing by default."""
+
+    # -- interference fits -------------------------------------------------------------
+    def capture_interference(self) -> None:
+        """Record each striker node's overlap in the current state (the start; collective).
+
+        Only with ``interference_until``: the overlap is the negative part of
+        the gap before any allowance.
+        """
+        if self.interference is None:
+            return
+        self.allowance.value = 0.0
+        self.refresh()
+        gap = self.surface.nodal(self._gap_form)
+        self.interference.x.array[:] = 0.0
+        self.interference.x.array[:gap.size] = np.maximum(-gap, 0.0)
+        self.interference.x.scatter_forward()
+
+    def ramp_interference(self, t: float) -> None:
+        """The allowance at load factor t: 1 - t / interference_until, down to 0."""
+        if self.interference is not None:
+            until = float(self.settings.interference_until)  # type: ignore[arg-type]
+            self.allowance.value = max(1.0 - t / until, 0.0)
+
+    @property
+    def ramping(self) -> bool:
+        """Whether part of the starting overlap is still allowed (the gap is shifted)."""
+        return self.interference is not None and float(self.allowance.value) > 0.0
+
+    def starting_overlap(self) -> np.ndarray | None:
+        """Owned nodal starting overlaps (length) of an interference fit; None without one."""
+        if self.interference is None:
+            return None
+        return np.array(self.interference.x.array[:self.interference.x.index_map.size_local])
 
     def refresh(self) -> bool:
         """Bring data that follow u up to date (a search); True when an assignment changed."""
@@ -257,7 +297,8 @@ class Contact:
             self.comm, gap, self.reported(pressure), lam, fem.assemble_scalar(force_form),
             active=pressure < 0.0,
         )
-        depth = self.penetration()
+        # while an interference is ramped the actual surfaces overlap by design
+        depth = None if self.ramping else self.penetration()
         if depth is not None:
             state = ContactState(**{**_fields(state), "max_penetration": depth,
                                     "constraint_penetration": state.max_penetration})

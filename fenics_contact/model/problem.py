@@ -84,6 +84,9 @@ class ContactProblem(FrictionalContacts):
         self.facet_tags, ids = facet_roles(self.domain, groups)
         for contact, tag_ids in zip(self.contacts, ids, strict=False):
             contact.bind(solid, self.facet_tags, tag_ids)
+        for contact in self.contacts:  # the overlaps an interference fit starts in
+            contact.capture_interference()
+            contact.ramp_interference(0.0)
         self.frictional = any(c.frictional for c in self.contacts)
         self.u_prev = fem.Function(self.V, name="displacement_prev") if self.frictional else None
         for contact in self.contacts:
@@ -247,6 +250,7 @@ class ContactProblem(FrictionalContacts):
         self.solid.set_load(t)
         for c in self.contacts:
             c.set_load(t)
+            c.ramp_interference(t)
 
     def obstacle_offset(self, t: float) -> np.ndarray:
         """The first contact's obstacle displacement at load factor t."""

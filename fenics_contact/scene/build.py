@@ -368,12 +368,14 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
         check_pair_surfaces(scene, body.domain, body.cell_tags, bodies, striker, target, pair)
         friction = (None if pair.mu is None
                     else FrictionSettings(pair.mu, pair.tangential_r_max))
+        settings = ContactSettings(r=pair.r, relative=pair.relative,
+                                   interference_until=pair.interference_until)
         if pair.discretisation == "mortar":
-            contacts.append(MortarContact(striker, target, ContactSettings(
-                r=pair.r, relative=pair.relative), friction=friction, name=pair.name))
+            contacts.append(MortarContact(striker, target, settings, friction=friction,
+                                          name=pair.name))
             continue
         contacts.append(NodeToSegmentContact(
-            striker, target, ContactSettings(r=pair.r, relative=pair.relative),
+            striker, target, settings,
             friction=friction, name=pair.name, self_contact=pair.self_contact,
             neighbourhood=pair.neighbourhood))
     paired = {frozenset(facet_owners(body.domain, body.cell_tags, bodies, np.concatenate(
@@ -469,10 +471,17 @@ def initial_penetration(contact: ObstacleContact) -> float:
     return float(contact.comm.allreduce(local, op=MPI.MAX))
 
 
-def warn_initial_penetration(scene: Scene, problem: ContactProblem) -> float:
-    """Warn (SceneWarning) when the body starts inside an obstacle by more than h.
+#: A body's start inside an obstacle deeper than this fraction of h is reported.
+SHALLOW_START = 1e-3
 
-    Returns the largest initial depth over the obstacles (length).
+
+def warn_initial_penetration(scene: Scene, problem: ContactProblem) -> float:
+    """Warn (SceneWarning) when the body starts inside an obstacle.
+
+    Past h: expect squashed elements, move the obstacle. Past
+    :data:`SHALLOW_START` h: the first load step pushes the body out (as two
+    bodies that start inside each other are reported). Returns the largest
+    initial depth over the obstacles (length).
     """
     deepest = 0.0
     obstacles = [c for c in problem.contacts if isinstance(c, ObstacleContact)]
@@ -480,9 +489,14 @@ def warn_initial_penetration(scene: Scene, problem: ContactProblem) -> float:
         depth = initial_penetration(contact)
         deepest = max(deepest, depth)
         h = contact.surface.h
+        which = "the obstacle" if len(obstacles) == 1 else f"obstacle '{contact.name}'"
+        if SHALLOW_START * h < depth <= h and contact.starting_overlap() is None:
+            warnings.warn(SceneWarning(
+                f"{scene.path.name}: the body starts {depth:.3g} ({depth / h:.2g} h) inside "
+                f"{which}; the first load step pushes it out. Move [obstacle] point/centre "
+                "if the gap at load 0 should be >= 0."), stacklevel=2)
         if depth <= h:
             continue
-        which = "the obstacle" if len(obstacles) == 1 else f"obstacle '{contact.name}'"
         #: What a failed run's advice repeats: the body started deep inside an obstacle.
         problem.initial_overlap = (f"the body starts {depth:.4g} inside {which} "
                                    f"({depth / h:.3g} h, the warning at the start)")

@@ -452,7 +452,18 @@ def check_initial_overlap(scene: Scene, problem: ContactProblem) -> float:
     """
     deepest = 0.0
     for contact in problem.contacts:
-        if contact.pair is not None:
+        fit = contact.starting_overlap()
+        limit = contact.surface.h
+        if fit is not None and contact.pair is not None:
+            # an interference fit: the overlap is meant and resolved along the load path;
+            # each striker node keeps the facet it projects on, at any depth
+            depth = np.where(contact.pair.projection.overshoot[:fit.size] <= 1e-12, fit, 0.0)
+            warn_from, limit = np.inf, np.inf
+        elif fit is not None and isinstance(contact, MortarContact):
+            # the weighted gaps hold within the segment search's reach only
+            depth = np.maximum(fit, contact.mortar.passed_through())
+            warn_from, limit = np.inf, FIT_REACH * contact.mortar.reach
+        elif contact.pair is not None:
             depth, warn_from = _projected_depth(contact), 1e-6
         elif isinstance(contact, MortarContact):
             # the weighted gaps of touching curved bodies read slightly negative
@@ -460,8 +471,12 @@ def check_initial_overlap(scene: Scene, problem: ContactProblem) -> float:
             depth, warn_from = _mortar_depth(contact), 1e-3
         else:
             continue
-        deepest = max(deepest, _refuse_deep_overlap(scene, contact, depth, warn_from))
+        deepest = max(deepest, _refuse_deep_overlap(scene, contact, depth, warn_from, limit))
     return deepest
+
+
+#: A mortar interference fit may start this fraction of the segment search's reach deep.
+FIT_REACH = 0.75
 
 
 def _projected_depth(contact) -> np.ndarray:
@@ -482,8 +497,9 @@ def _mortar_depth(contact: MortarContact) -> np.ndarray:
     return np.maximum(weighted, contact.mortar.passed_through())
 
 
-def _refuse_deep_overlap(scene: Scene, contact, depth: np.ndarray, warn_from: float) -> float:
-    """Raise past the striker facet size h, warn past ``warn_from`` h; return the deepest depth."""
+def _refuse_deep_overlap(scene: Scene, contact, depth: np.ndarray, warn_from: float,
+                        limit: float) -> float:
+    """Raise past ``limit`` (length), warn past ``warn_from`` h; return the deepest depth."""
     worst = int(np.argmax(depth)) if depth.size else None
     found = _first_on_any_rank(
         contact.comm,
@@ -498,17 +514,28 @@ def _refuse_deep_overlap(scene: Scene, contact, depth: np.ndarray, warn_from: fl
               for role in ("striker", "target")]
     who = (f"[[pair]] {contact.name!r}: the bodies {bodies[0]!r} and {bodies[1]!r}"
            if None not in bodies else f"[[pair]] {contact.name!r}: the bodies")
-    if deepest > h:
+    if deepest > limit and contact.starting_overlap() is not None:
+        raise SceneError(
+            f"{scene.path.name}: {who} start {deepest:.4g} inside each other near {where}, "
+            f"deeper than a mortar interference fit may start ({limit:.4g}, "
+            f"{FIT_REACH:g} of the segment search's reach of 2 facet sizes): the weighted gaps "
+            "are not measured there. Use coarser facets on the fit's surfaces, or "
+            'discretisation = "node-to-segment", whose nodes keep their facet at any depth.'
+        )
+    if deepest > limit:
         raise SceneError(
             f"{scene.path.name}: {who} start {deepest:.4g} inside each other near {where}, "
             f"more than the striker facet size h = {h:.4g}; move one body out of the other in "
-            "the mesh and let [[dirichlet]] values bring them into contact."
+            "the mesh and let [[dirichlet]] values bring them into contact, or, for an "
+            "interference fit meshed before assembly, give the pair interference_until "
+            "(the overlap is then resolved along the load path)."
         )
     if deepest > warn_from * h:
         warnings.warn(
             SceneWarning(
                 f"{scene.path.name}: {who} start {deepest:.3g} ({deepest / h:.2g} h) inside "
-                f"each other near {where}; the first load step pushes them apart."
+                f"each other near {where}; the first load step pushes them apart (for an "
+                "interference fit resolved along the load path: interference_until)."
             ),
             stacklevel=2,
         )

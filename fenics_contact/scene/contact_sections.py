@@ -178,6 +178,7 @@ def read_pairs(path: Path, data: dict[str, Any], dimension: int = 2) -> tuple[Pa
             self_contact=self_contact,
             neighbourhood=reader.number("neighbourhood", 3.0, positive=True),
             discretisation=_discretisation(reader, dimension, two_surfaces),
+            interference_until=_interference_until(reader),
         ))
     _refuse_repeated_surfaces(path, out)
     return tuple(out)
@@ -200,6 +201,18 @@ def _refuse_repeated_surfaces(path: Path, pairs: list[PairSpec]) -> None:
                 '"mortar".'
             )
         seen[key] = pair.name
+
+
+def _interference_until(reader: _Reader) -> float | None:
+    """[[pair]] interference_until: a load factor in (0, 1], or None (absent)."""
+    if "interference_until" not in reader.table:
+        return None
+    value = reader.number("interference_until", positive=True)
+    if value > 1.0:
+        raise reader.fail("interference_until", "is the load factor by which the starting "
+                          "overlap is resolved: give a number in (0, 1] (1: over the whole "
+                          "load path).")
+    return value
 
 
 def _discretisation(reader: _Reader, dim: int, two_surfaces: bool) -> str:

@@ -222,6 +222,11 @@ KEY_DOCS: dict[str, dict[str, KeyDoc]] = {
                                  "(exact on non-matching meshes; 2D and 3D, with or without "
                                  "friction; self-contact of two surfaces of one body too).",
                                  field="PairSpec.discretisation"),
+        "interference_until": KeyDoc("number in (0, 1]", "An interference fit: the surfaces "
+                                     "start inside each other (meshed before assembly) and "
+                                     "the overlap is resolved in proportion to the load factor "
+                                     "until this one (absent: by the first load step).", "",
+                                     "absent", field="PairSpec.interference_until"),
     },
     "pairing": {
         "automatic": KeyDoc("boolean", "Pair every body's exterior surface with every other "

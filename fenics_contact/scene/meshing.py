@@ -177,6 +177,17 @@ def open_geo(gmsh: Any, path: Path | str, parameters: dict[str, float]) -> None:
                 raise ValueError(f"{Path(path).name} declares no parameter "
                                  f"{', '.join(map(repr, unknown))}; " + "; ".join(renamed)
                                  + f" (it declares: {', '.join(sorted(declared))}).")
+            # declared under another ONELAB path: x = {1, Name "P/x"}
+            elsewhere = {k: v for k, v in re.findall(
+                r"(\w+)\s*=\s*\{[^}]*Name\s*\"([^\"]+)\"", Path(path).read_text(
+                    errors="replace")) if not v.startswith("Parameters/")}
+            misplaced = [f"{k!r} is declared with Name {elsewhere[k]!r}; only names under "
+                         f'"Parameters/" can be set from a scene: Name "Parameters/{k}"'
+                         for k in unknown if k in elsewhere]
+            if misplaced:
+                raise ValueError(f"{Path(path).name} declares no parameter "
+                                 f"{', '.join(map(repr, unknown))}; " + "; ".join(misplaced)
+                                 + ".")
             raise ValueError(
                 f"{Path(path).name} declares no parameter {', '.join(map(repr, unknown))}; "
                 f"it declares: {', '.join(sorted(declared)) or 'none'}. A parameter the scene "

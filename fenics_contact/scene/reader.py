@@ -15,7 +15,7 @@ KEYS: dict[str, set[str]] = {
     "pairing": {"automatic", "r", "relative", "mu", "tangential_r_max", "margin"},
     "body": {"name", "tag", "law", "E", "nu"},
     "pair": {"name", "striker", "target", "r", "relative", "mu", "tangential_r_max",
-             "self_contact", "neighbourhood", "discretisation"},
+             "self_contact", "neighbourhood", "discretisation", "interference_until"},
     "scene": {"name", "dimension", "description"},
     "mesh": {"file", "generator", "origin", "size", "cells", "cell", "parameters"},
     "material": {"law", "E", "nu", "kinematics"},

@@ -88,6 +88,8 @@ class PairSpec:
     neighbourhood: float = 3.0
     #: "node-to-segment" (one pass, the default) or "mortar" (segment to segment, 2D and 3D).
     discretisation: str = "node-to-segment"
+    #: Load factor by which a starting overlap (an interference fit) is resolved; None: at once.
+    interference_until: float | None = None
 
 
 @dataclass(frozen=True)
