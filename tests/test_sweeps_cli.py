@@ -133,3 +133,28 @@ def test_study_beside_another_scene_with_relative_r_fills_the_table(tmp_path):
     rows = [line.split("|")[3:5] for line in lines[2:]]
     assert len(rows) == 2  # one per scene, every cell an iteration count
     assert all(cell.strip().isdigit() for row in rows for cell in row), lines
+
+
+def test_sweeps_on_a_frictional_scene_with_several_contacts(tmp_path):
+    """block_floor_wall: a frictionless floor and a frictional wall (mu = 0.2).
+
+    ``tradeoff`` used to stop with AttributeError (it read stick/slip from
+    the first contact, the floor); ``stability`` divided the wall's F_t by
+    mu times every contact's N (0.085). Both now take F_t / (mu N) over the
+    frictional contacts: the wall slips at 0.98 of its limit.
+    """
+    code = main(["tradeoff", str(SCENES / "block_floor_wall.toml"), "--methods", "gnrm",
+                 "--r", "1", "--repeats", "1", "--out", str(tmp_path / "trade")])
+    assert code == 0
+    (row,) = read_csv(tmp_path / "trade" / "tradeoff.csv")
+    assert row["status"] == "converged" and float(row["stick_slip"]) < 1e-12
+    code = main(["stability", str(SCENES / "block_floor_wall.toml"), "--methods", "gnrm",
+                 "--r", "1", "--out", str(tmp_path / "stab")])
+    assert code == 0
+    (row,) = read_csv(tmp_path / "stab" / "stability.csv")
+    record = json.loads((tmp_path / "stab" / "stability.json").read_text())[0]
+    wall = record["steps"][-1]["contacts"]["wall"]
+    assert record["mus"] == {"wall": 0.2}
+    assert float(row["ft_ratio"]) == pytest.approx(
+        wall["tangential_force"] / (0.2 * wall["normal_force"]), rel=1e-12)
+    assert float(row["ft_ratio"]) == pytest.approx(0.98138, abs=1e-4)

@@ -42,6 +42,15 @@ class FrictionalContacts:
         """The first frictional contact's mu (dimensionless)."""
         return float(self.mu.value)
 
+    def friction_coefficients(self) -> dict[str, float]:
+        """Each frictional contact's mu by the contact's name (empty without friction)."""
+        return {c.name: float(c.friction.mu.value) for c in self.contacts
+                if c.friction is not None}
+
+    def frictional_states(self) -> list:
+        """The contact state (with stick/slip) of every frictional contact (collective)."""
+        return [c.contact_state() for c in self.contacts if c.friction is not None]
+
     @property
     def contact_extent(self) -> float:
         """Extent L of the first frictional contact's surface (length)."""

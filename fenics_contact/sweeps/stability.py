@@ -27,7 +27,7 @@ import math
 import time
 import traceback
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -41,6 +41,7 @@ from fenics_contact.solvers import STRATEGIES, make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings, Status
 from fenics_contact.solvers.stepping import RunRecord, StepRecord, solve_load_path, start_record
 from fenics_contact.sweeps.cases import Case, build_case, case_steps
+from fenics_contact.sweeps.coulomb import coulomb_ratio
 
 #: Methods the stability grid runs by default.
 METHODS = tuple(STRATEGIES)
@@ -109,8 +110,10 @@ class CaseRecord(RunRecord):
     #: displacement measure to compare with a reference (max |u| is often
     #: the prescribed value).
     u_rms: float = 0.0
-    #: Coulomb coefficient (None without friction).
+    #: Coulomb coefficient (None without friction; the first frictional contact's).
     mu: float | None = None
+    #: Each frictional contact's mu by name (F_t / (mu N) is taken over them).
+    mus: dict[str, float] = field(default_factory=dict)
     #: Where the reference answer came from ("gnrm r=1"; empty: none).
     reference: str = ""
     #: Largest relative deviation of N, F_t (both relative to the reference N)
@@ -124,10 +127,15 @@ class CaseRecord(RunRecord):
 
     @property
     def ft_ratio(self) -> float | None:
-        """F_t / (mu N) at the last step attempted (1: full slip; None without friction)."""
-        if not self.mu or self.contact_force <= 0.0:
+        """F_t / (mu N) at the last step attempted over the frictional contacts (1: full slip).
+
+        None without friction or load. Each frictional contact counts with its own mu;
+        frictionless ones (a wall) are left out (:func:`~.coulomb.coulomb_ratio`).
+        """
+        if not self.mus or not self.steps:
             return None
-        return self.tangential_force / (self.mu * self.contact_force)
+        ratio = coulomb_ratio(self.steps[-1], self.mus)
+        return None if math.isnan(ratio) else ratio
 
     @property
     def reference_reached(self) -> bool | None:
@@ -181,6 +189,7 @@ def run_case(
     try:
         problem = build_case(scene, case.r, True, None, comm)
         record.mu = problem.friction_coefficient if problem.frictional else None
+        record.mus = problem.friction_coefficients() if problem.frictional else {}
         atol = scaled_atol(problem, force_rtol)
         strategy = make_strategy(
             method, problem, SolverSettings(atol=atol, max_iterations=max_iterations)
@@ -217,7 +226,8 @@ def run_case(
 
 def _case_fields(record: CaseRecord) -> dict[str, object]:
     """The case's own fields of a record (not the run's)."""
-    return {k: getattr(record, k) for k in ("case", "group", "E", "nu", "load_steps", "mu")}
+    return {k: getattr(record, k)
+            for k in ("case", "group", "E", "nu", "load_steps", "mu", "mus")}
 
 
 def deviation(record: CaseRecord, reference: CaseRecord) -> float | None:

@@ -47,6 +47,7 @@ from fenics_contact.solvers.stepping import (
     start_record,
 )
 from fenics_contact.sweeps.cases import build_case, case_steps
+from fenics_contact.sweeps.coulomb import coulomb_ratio
 from fenics_contact.sweeps.study import relative_l2_error
 
 #: r values relative to E/h of the full sweep: 1e-4 ... 1e8, a decade apart.
@@ -172,14 +173,15 @@ class FrictionMeter:
         """Measure the problem's state at the end of ``step``."""
         start = time.perf_counter()
         p = self.problem
-        state = p.contact_state()
-        stuck = state.node_state == STICK
-        local = float(np.max(np.linalg.norm(state.slip[stuck], axis=1), initial=0.0))
+        local = 0.0
+        for state in p.frictional_states():  # frictionless contacts have no stick
+            stuck = state.node_state == STICK
+            local = max(local, float(np.max(np.linalg.norm(state.slip[stuck], axis=1),
+                                            initial=0.0)))
         self.stick_slip = max(self.stick_slip, p.comm.allreduce(local, op=MPI.MAX))
         if self.multiplier:
             self.t_residual = max(self.t_residual, p.complementarity_norms()[1])
-        limit = p.friction_coefficient * step.contact_force
-        self.ratios[step.step] = step.tangential_force / limit if limit > 0 else math.nan
+        self.ratios[step.step] = coulomb_ratio(step, p.friction_coefficients())
         self.elapsed_s += time.perf_counter() - start
 
     def score(self, record: TradeoffRecord, reference: Reference | None) -> None:

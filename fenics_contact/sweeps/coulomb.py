@@ -1,0 +1,30 @@
+"""F_t / (mu N) of a load step over its frictional contacts.
+
+With several contacts the step's totals mix frictionless contacts (a wall,
+a floor) into N and several coefficients into mu: the ratio is taken over
+the frictional contacts only, each with its own mu,
+
+    sum_c F_t,c / sum_c mu_c N_c,
+
+which is 1 when every frictional contact slips (Coulomb's limit reached
+everywhere) and below 1 while some node sticks.
+"""
+
+from __future__ import annotations
+
+import math
+
+from fenics_contact.solvers.stepping import StepRecord
+
+
+def coulomb_ratio(step: StepRecord, mus: dict[str, float]) -> float:
+    """F_t / (mu N) over the contacts named in ``mus`` (name -> mu); NaN without a load."""
+    numbers = [step.contacts[name] for name in mus if name in step.contacts]
+    limit = sum(mus[name] * step.contacts[name]["normal_force"]
+                for name in mus if name in step.contacts)
+    if not numbers or limit <= 0.0:
+        return math.nan
+    return sum(n["tangential_force"] for n in numbers) / limit
+
+
+__all__ = ["coulomb_ratio"]
