@@ -48,6 +48,16 @@ def test_every_interface_carries_the_applied_force_with_a_uniform_pressure(tmp_p
         pressure = np.concatenate(MPI.COMM_WORLD.allgather(state.pressure))
         assert pressure.size == 11 and np.allclose(pressure, -EXACT, rtol=1e-9), name
         assert state.max_penetration < 1e-12, name
+    # the force each striker hands to its target's vertices, summed over the two pairs
+    # (before 2026-12-02 the written field held the first pair's only: 0 on the bottom block)
+    problem = outcome.problem
+    force = problem.target_force().x.array.reshape(-1, 2)
+    owned = problem.V.dofmap.index_map.size_local
+    for body, expected in (("bottom", -EXACT), ("middle", -EXACT), ("top", 0.0)):
+        tag = next(b.tag for b in problem.solid.bodies if b.name == body)
+        dofs = np.unique(problem.V.dofmap.list[problem.solid.cell_tags.find(tag)].ravel())
+        total = MPI.COMM_WORLD.allreduce(force[dofs[dofs < owned]].sum(axis=0))
+        assert total == pytest.approx([0.0, expected], abs=1e-9), body
 
 
 def test_non_matching_interfaces_pass_the_load_down(tmp_path):

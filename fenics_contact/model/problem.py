@@ -442,8 +442,19 @@ class ContactProblem(FrictionalContacts):
         return balls_passed_through(self.V, self.u, self.contacts)
 
     def target_force(self) -> fem.Function:
-        """Force the first contact's striker puts on its target's vertices (pairs only)."""
-        return self.contact.target_force()
+        """Force the strikers put on their targets' vertices, summed over the pairs (force).
+
+        Every two-body and self-contact pair adds its own (a body that is the
+        target of one pair and the striker of another carries the first
+        one's only: a striker's own nodes take their force as the multiplier).
+        Zero where no pair has a target (everywhere without pairs).
+        """
+        pairs = [c for c in self.contacts if hasattr(c, "target_force")]
+        total = fem.Function(self.V, name="target_contact_force")
+        for contact in pairs:
+            total.x.array[:] += contact.target_force().x.array
+        total.x.scatter_forward()
+        return total
 
 
 __all__ = [
