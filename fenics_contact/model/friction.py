@@ -113,6 +113,8 @@ def symmetry_planes(
     A condition is one when it holds exactly one displacement component at 0
     (the others free) on facets that all lie in one plane normal to that
     component's axis, e.g. u_y = 0 on the face y = 0 of a half model.
+    Conditions on the same plane (one per body of a half model, tagged
+    apart) are one plane: their facets are joined.
     """
     x = domain.geometry.x
     fdim = domain.topology.dim - 1
@@ -134,8 +136,16 @@ def symmetry_planes(
         lo = comm.allreduce(float(np.min(coords, initial=np.inf)), op=MPI.MIN)
         hi = comm.allreduce(float(np.max(coords, initial=-np.inf)), op=MPI.MAX)
         if np.isfinite(lo) and hi - lo <= 1e-12 * span:
-            planes.append((facets, axis))
-    return planes
+            planes.append((facets, axis, lo))
+    joined: list[tuple[np.ndarray, int, float]] = []
+    for facets, axis, where in planes:
+        same = next((k for k, (_, a, w) in enumerate(joined)
+                     if a == axis and abs(w - where) <= 1e-12 * span), None)
+        if same is None:
+            joined.append((facets, axis, where))
+        else:
+            joined[same] = (np.union1d(joined[same][0], facets).astype(np.int32), axis, where)
+    return [(facets, axis) for facets, axis, _ in joined]
 
 
 def held_components(conditions: Sequence[object]) -> list[tuple[np.ndarray, int, str]]:
