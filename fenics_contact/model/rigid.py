@@ -170,6 +170,7 @@ def free_assembly_motion(
     conditions: Sequence[tuple[np.ndarray, Sequence[float | None]]],
     contact_gaps: Callable[[np.ndarray], np.ndarray],
     tractions: Sequence[tuple[np.ndarray, Sequence[float]]] = (),
+    touching: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> list[tuple[str, str]]:
     """A rigid motion of the assembly that nothing holds, body by body ([] when held).
 
@@ -194,14 +195,16 @@ def free_assembly_motion(
             displacement given per geometry node, shape (nodes, gdim) (length).
         tractions: (local facet indices, traction at load factor 1) of each
             surface traction.
+        touching: the mask of the gaps at the start that count as closed
+            (collective; None: those at most 1e-9 of the assembly's size).
 
     Returns:
         (body name, its part of the motion in words) for each body that the
         free motion found moves; empty when every rigid motion is held.
         Collective.
     """
-    return AssemblyModes(domain, bodies, conditions).free_motion(contact_gaps,
-                                                                 tractions=tractions)
+    return AssemblyModes(domain, bodies, conditions).free_motion(
+        contact_gaps, tractions=tractions, touching=touching)
 
 
 class AssemblyModes:
@@ -284,6 +287,7 @@ class AssemblyModes:
         displacement: np.ndarray | None = None,
         holding: Callable[[np.ndarray], np.ndarray] | None = None,
         tractions: Sequence[tuple[np.ndarray, Sequence[float]]] = (),
+        touching: Callable[[np.ndarray], np.ndarray] | None = None,
     ) -> list[tuple[str, str]]:
         """A rigid motion that neither the conditions nor the contacts hold ([] when held).
 
@@ -301,6 +305,8 @@ class AssemblyModes:
                 those that hold both ways, as the active set of a Newton step does.
             tractions: (local facet indices, traction at load factor 1) of each
                 surface traction: at the start a motion they oppose is held.
+            touching: at the start, the mask of the gaps that are closed
+                (None: at most 1e-9 size).
 
         Returns:
             (body name, its part of the motion in words) per moving body. Collective.
@@ -314,7 +320,10 @@ class AssemblyModes:
         # d measure / d mode at the closed nodes, for the modes the conditions leave free
         step = 1e-7 * size
         base = contact_values(start)
-        closed = base <= 1e-9 * size if holding is None else holding(base)
+        if holding is not None:
+            closed = holding(base)
+        else:
+            closed = base <= 1e-9 * size if touching is None else touching(base)
         columns = [(contact_values(start + step * self.mode_field(x, free[:, j], centre, size))
                     - base)[closed] / step for j in range(free.shape[1])]
         resist = np.vstack(self.domain.comm.allgather(np.column_stack(columns)))

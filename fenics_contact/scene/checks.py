@@ -430,12 +430,41 @@ def free_motion_of_contacts(
         u.x.array.reshape(-1, gdim)[block[mapped]] = displacement[mapped]
         return np.concatenate([c.contact_state().gap for c in problem.contacts])
 
+    def touching(base: np.ndarray) -> np.ndarray:
+        """Closed at the start: a gap of zero, and on a mortar pair its touching nodes.
+
+        A mortar pair's weighted gap is the gap's mean over a node's support: at
+        the point where two curved surfaces touch it reads h^2 / 12 R (R the
+        relative radius of curvature), not 0. Its smallest gap, when below
+        TOUCHING h (any R down to about h), and the gaps within 1e-12 h of it
+        touch.
+        """
+        out, start = [], 0
+        for c in problem.contacts:
+            n = c.lam.x.index_map.size_local
+            g = base[start:start + n]
+            start += n
+            closed = g <= 1e-9 * float(c.surface.h)
+            if isinstance(c, MortarContact):
+                h = float(c.surface.h)
+                smallest = problem.comm.allreduce(float(np.min(g, initial=np.inf)), op=MPI.MIN)
+                if smallest <= TOUCHING * h:
+                    closed |= g <= max(smallest, 0.0) + 1e-12 * h
+            out.append(closed)
+        return np.concatenate(out) if out else np.zeros(0, bool)
+
     try:
         return free_assembly_motion(domain, bodies, [(p.facets, p.at(1.0)) for p in prescribed],
-                                    gaps, [(t.facets, t.value) for t in problem.solid.tractions])
+                                    gaps, [(t.facets, t.value) for t in problem.solid.tractions],
+                                    touching=touching)
     finally:
         u.x.array[:] = 0.0
         problem.refresh_search()
+
+
+#: A mortar pair's smallest weighted gap at the start below this many h touches
+#: (h / 12 R of it where curved surfaces touch at a point, R >= h).
+TOUCHING = 0.1
 
 
 def check_initial_overlap(scene: Scene, problem: ContactProblem) -> float:
