@@ -69,3 +69,33 @@ def test_surface_values_land_on_the_striker_vertices(tmp_path) -> None:
     target = np.setdiff1d(on_interface, striker)
     assert comm.allreduce(target.size, op=MPI.SUM) > 0
     assert np.all(written[target] == 0.0)
+
+
+def test_fields_at_a_node_two_contacts_share(tmp_path) -> None:
+    """block_floor_wall: the corner node lies on the floor's and the wall's facets.
+
+    Pressures add there, the gap is the smaller, active and stick/slip the
+    larger: a node in contact with the wall but open to the floor was
+    written open with the floor's gap (a user's 3D pair and wall: the four
+    edge nodes of the peak pressure drawn open).
+    """
+    from fenics_contact.output.io import ContactsToBody
+    from fenics_contact.output.xdmf import SHARED_NODE
+
+    problem = build_problem(load_scene(Path(__file__).parents[1] / "scenes"
+                                       / "block_floor_wall.toml"))
+    mapper = ContactsToBody(problem)
+    sizes = [c.lam.x.index_map.size_local for c in problem.contacts]
+    assert len(sizes) == 2
+    first, second = np.full(sizes[0], 1.0), np.full(sizes[1], 2.0)
+    dofs = [m.body_dofs for m, _ in mapper._maps]
+    shared = np.intersect1d(dofs[0], dofs[1])
+    only = np.setdiff1d(dofs[0], dofs[1])
+    assert MPI.COMM_WORLD.allreduce(shared.size) >= 1  # the corner
+    expected = {"add": 3.0, "min": 1.0, "max": 2.0, "last": 2.0}
+    for combine, value in expected.items():
+        field = mapper.field("f", [first, second], combine=combine)
+        assert np.all(field.x.array[shared] == value), combine
+        assert np.all(field.x.array[only] == 1.0), combine
+    assert SHARED_NODE == {"contact_pressure": "add", "gap": "min", "active": "max",
+                           "stick_slip": "max"}

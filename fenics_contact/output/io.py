@@ -99,7 +99,9 @@ class ContactsToBody:
 
     Off every contact surface the field is zero. Where two contacts share a
     node (a body touching two obstacles at a corner) pressures and tractions
-    add; other values are the later contact's.
+    add, the gap is the smaller one and the active and stick/slip marks the
+    larger one (a node in contact anywhere is not written open); other
+    values are the later contact's.
     """
 
     def __init__(self, problem: ContactProblem) -> None:
@@ -115,16 +117,28 @@ class ContactsToBody:
         q.x.scatter_forward()
         return q.x.array
 
-    def field(self, name: str, per_contact: list[np.ndarray], *, add: bool = False
-              ) -> fem.Function:
-        """A body P1 function from each contact's owned nodal values."""
+    def field(self, name: str, per_contact: list[np.ndarray], *, add: bool = False,
+              combine: str = "last") -> fem.Function:
+        """A body P1 function from each contact's owned nodal values.
+
+        At a node two contacts share: ``add`` (or ``combine = "add"``) sums,
+        ``"min"`` and ``"max"`` keep the smaller or larger value, ``"last"``
+        the later contact's.
+        """
+        combine = "add" if add else combine
         f = fem.Function(self.W, name=name)
+        seen = np.zeros(f.x.array.size, bool)
         for (mapper, q), values in zip(self._maps, per_contact, strict=True):
             local = self._local(values, q)
-            if add:
-                f.x.array[mapper.body_dofs] += local
+            dofs = mapper.body_dofs
+            if combine == "add":
+                f.x.array[dofs] += local
+            elif combine in ("min", "max"):
+                pick = np.minimum if combine == "min" else np.maximum
+                f.x.array[dofs] = np.where(seen[dofs], pick(f.x.array[dofs], local), local)
             else:
-                f.x.array[mapper.body_dofs] = local
+                f.x.array[dofs] = local
+            seen[dofs] = True
         return f
 
     def vector_field(self, name: str, per_contact: list[np.ndarray], *, add: bool = False

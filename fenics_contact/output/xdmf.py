@@ -37,6 +37,11 @@ from fenics_contact.scene.schema import FIELDS, FRICTION_FIELDS
 _STEP = re.compile(r"step_(\d{4,})\.(h5|xdmf)$")
 
 
+#: How a surface field combines at a node two contacts share: pressures add, the
+#: nearer partner's gap, and a node in contact anywhere is in contact.
+SHARED_NODE = {"contact_pressure": "add", "gap": "min", "active": "max", "stick_slip": "max"}
+
+
 def step_folder(index: Path) -> Path:
     """The folder of the per-step files of index ``DIR/NAME.xdmf``: ``DIR/NAME``."""
     return index.with_suffix("")
@@ -264,7 +269,7 @@ class StepWriter:
                             name, vectors[name], add=name == "tangential_traction"), t)
                     else:
                         file.write_function(self.mapper.field(
-                            name, surface[name], add=name == "contact_pressure"), t)
+                            name, surface[name], combine=SHARED_NODE.get(name, "last")), t)
                 if self._body_id is not None:
                     file.write_function(self._body_id, t)
                     file.write_function(p.target_force(), t)
