@@ -84,6 +84,15 @@ def test_a_stack_without_its_floor_is_refused_naming_the_free_block(tmp_path):
         build_problem(load_scene(path), MPI.COMM_SELF)
 
 
+def test_a_floor_that_the_stack_does_not_touch_is_named(tmp_path):
+    """The floor 0.1 below the bottom block: the refusal names the contact open everywhere."""
+    path = variant(tmp_path, "point = [0.0, 0.0]", "point = [0.0, -0.1]")
+    with pytest.raises(SceneError, match=r"\[\[body\]\] 'bottom' can move rigidly .*the "
+                       r"contacts do not hold it at the start \(open everywhere at the start: "
+                       r"'floor'\)"):
+        build_problem(load_scene(path), MPI.COMM_SELF)
+
+
 def test_the_block_left_free_is_the_one_named(tmp_path):
     """The symmetry plane kept on the lower and upper blocks only: the middle block, held
     in y by its neighbours, slides in x (before, the message named the bottom block)."""

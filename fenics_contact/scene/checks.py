@@ -389,7 +389,8 @@ def check_bodies_held(
                 "together (" + "; ".join(f"{n!r}: {m}" for n, m in moving) + ")")
     raise SceneError(
         f"{scene.path.name}: {what}: no [[dirichlet]] condition holds that motion, and the "
-        f"contacts do not hold it at the start: one open, or touching with no pressure yet, "
+        f"contacts do not hold it at the start{_open_at_start(problem)}: one open, or "
+        "touching with no pressure yet, "
         f"holds nothing before the load presses it (nor along it: friction is not counted "
         f"as a support, and a traction holds only the motions it presses into a contact). "
         f"Fix: prescribe components on a face of {name!r} (e.g. a support, a "
@@ -405,6 +406,17 @@ def held_by_closed_contacts(
 ) -> bool:
     """Whether the conditions and the contacts closed at load 0 hold every body (see rigid.py)."""
     return not free_motion_of_contacts(problem, bodies, prescribed)
+
+
+def _open_at_start(problem: ContactProblem) -> str:
+    """" (open everywhere at the start: 'far', 'wall')": the contacts that touch nowhere."""
+    found = []
+    for c in problem.contacts:
+        gap = c.contact_state().gap
+        smallest = problem.comm.allreduce(float(np.min(gap, initial=np.inf)), op=MPI.MIN)
+        if np.isfinite(smallest) and smallest > TOUCHING * float(c.surface.h):
+            found.append(repr(c.name))
+    return f" (open everywhere at the start: {', '.join(found)})" if found else ""
 
 
 def free_motion_of_contacts(
