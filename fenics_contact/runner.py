@@ -114,6 +114,7 @@ def _summary(scene: Scene, record: RunRecord, used: dict[str, dict] | None = Non
                 **built(pair.name), "mu": pair.mu, "tangential_r_max": pair.tangential_r_max,
                 "quadrature": used.get(pair.name, {}).get("quadrature", "nodal"),
                 "discretisation": pair.discretisation, "self_contact": pair.self_contact,
+                "interference_until": pair.interference_until,
                 "steps": _contact_steps(record, pair.name, pair.mu is not None),
             }
             for pair in scene.pairs

@@ -60,10 +60,11 @@ def test_every_contact_has_its_own_settings(stack):
     scale = {c.name: c.stiffness_scale for c in outcome.problem.contacts}
     first, second = summary["pairs"]
     assert {k: first[k] for k in ("name", "striker", "target", "automatic", "r", "relative",
-                                  "mu", "quadrature", "discretisation", "self_contact")} == {
+                                  "mu", "quadrature", "discretisation", "self_contact",
+                                  "interference_until")} == {
         "name": "top-on-middle", "striker": "top_underside", "target": "middle_topside",
         "automatic": False, "r": 2.0, "relative": True, "mu": 0.2, "quadrature": "nodal",
-        "discretisation": "node-to-segment", "self_contact": False}
+        "discretisation": "node-to-segment", "self_contact": False, "interference_until": None}
     assert first["r_absolute"] == pytest.approx(2.0 * scale["top-on-middle"], rel=1e-14)
     assert first["r_absolute"] == r_used["top-on-middle"]
     assert (second["r"], second["relative"], second["mu"]) == (300.0, False, None)
