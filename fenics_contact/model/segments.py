@@ -157,11 +157,14 @@ def overlaps(x1: np.ndarray, x2: np.ndarray, ta: np.ndarray, tb: np.ndarray,
         x2: (n, 2) their second end points.
         ta: (m, 2) current first end points of m target facets.
         tb: (m, 2) their second end points.
-        reach: largest |normal distance| of a target facet that counts (length).
+        reach: largest distance of a target facet along the striker facet's
+            normal that counts (length): its normal distance over the cosine
+            between the facets (a facet tilted away, near in its own normal
+            but far along the striker's, does not count).
 
     Returns (n, m) arrays: the length in [0, 1] local coordinates of the
     projection overlap (-inf where the facets do not face each other or lie
-    farther than ``reach``; slightly
+    farther than ``reach`` along the striker's normal; slightly
     negative values, down to -MARGIN, for near misses), and the normal
     distance relative to the striker facet's length.
     """
@@ -179,7 +182,7 @@ def overlaps(x1: np.ndarray, x2: np.ndarray, ta: np.ndarray, tb: np.ndarray,
     mid = x1[:, None] + (0.5 * (lo + hi))[..., None] * t[:, None]
     dist = np.abs(np.einsum("nmi,mi->nm", ta[None] - mid, nt))
     out = hi - lo
-    out[(cos < OPPOSING) | (dist > reach) | (out < -MARGIN)] = -np.inf
+    out[(cos < OPPOSING) | (dist > reach * np.maximum(cos, 0.0)) | (out < -MARGIN)] = -np.inf
     return out, dist / np.sqrt(tt)[:, None]
 
 
