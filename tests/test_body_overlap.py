@@ -109,3 +109,28 @@ def test_an_overlap_at_an_earlier_step_is_named_with_its_step(tmp_path):
                       r"inside body 'upper'", said[0])
     assert found, said[0]
     assert 20 < int(found.group(1)) < 36 and float(found.group(3)) > 100 * WARN_DEPTH
+
+
+def test_an_overlap_between_bodies_of_several_pairs_goes_to_the_nearest_pair():
+    """Two bodies joined by two pairs: the overlap is laid to the pair nearest it.
+
+    A user's indenter pressed a block's top through a mortar pair, and a
+    node-to-segment pair joined the block's side to the indenter (never
+    touching): a node at the mortar interface 2.4 % of h inside was named
+    under the side pair, with node-to-segment's 1 % allowance and advice.
+    """
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from fenics_contact.scene.body_overlap import _nearest_pair
+
+    top = SimpleNamespace(name="top", nodal_coordinates=lambda: np.array(
+        [[x, 1.0, 0.0] for x in np.linspace(0.0, 1.0, 11)]))
+    side = SimpleNamespace(name="side", nodal_coordinates=lambda: np.array(
+        [[0.0, y, 0.0] for y in np.linspace(0.0, 0.9, 10)]))
+    problem = SimpleNamespace(comm=MPI.COMM_SELF,
+                              domain=SimpleNamespace(geometry=SimpleNamespace(dim=2)))
+    assert _nearest_pair(problem, [side, top], np.array([0.52, 0.998])).name == "top"
+    assert _nearest_pair(problem, [side, top], np.array([0.01, 0.4])).name == "side"
+    assert _nearest_pair(problem, [side], np.array([0.52, 0.998])).name == "side"

@@ -92,27 +92,51 @@ class PairOverlap:
         return self.depth > (WARN_DEPTH_MORTAR if self.mortar else WARN_DEPTH) * self.h
 
 
+def _nearest_pair(problem: ContactProblem, contacts: list, point: np.ndarray):
+    """Of the pairs joining two bodies, the one whose striker nodes lie nearest ``point``."""
+    if len(contacts) == 1:
+        return contacts[0]
+    gdim = problem.domain.geometry.dim
+    distance = []
+    for contact in contacts:
+        x = contact.nodal_coordinates()[:, :gdim]
+        near = float(np.min(np.linalg.norm(x - point[:gdim], axis=1), initial=np.inf))
+        distance.append(problem.comm.allreduce(near, op=MPI.MIN))
+    return contacts[int(np.argmin(distance))]
+
+
 def pair_overlaps(problem: ContactProblem) -> list[PairOverlap]:
-    """The deepest overlap of each two-body pair, both ways (collective)."""
+    """The deepest overlap of each pair of bodies that pairs join, both ways (collective).
+
+    Two bodies joined by several pairs (an indenter on a block's top, and a
+    second pair on its side) are measured once, and the overlap is laid to
+    the pair whose striker nodes lie nearest it: its allowance and its
+    advice apply.
+    """
     comm, out = problem.comm, []
+    groups: dict[frozenset, list] = {}
     for contact in problem.contacts:
         striker, target = getattr(contact, "striker_body", None), getattr(contact, "target_body",
                                                                           None)
         if striker is None or target is None or striker is target:
             continue  # self-contact: scene/self_overlap.py
-        if contact.ramping:
+        groups.setdefault(frozenset((striker.name, target.name)), []).append(contact)
+    for contacts in groups.values():
+        if any(c.ramping for c in contacts):
             continue  # an interference fit not yet resolved: the bodies overlap by design
+        striker, target = contacts[0].striker_body, contacts[0].target_body
         surfaces = body_surfaces(problem.domain, problem.solid.cell_tags, [target, striker])
         sides = [surfaces[b.name] for b in (target, striker)]
         found = [_inside(problem, sides[0], sides[1]), _inside(problem, sides[1], sides[0])]
         depths = [comm.allreduce(d, op=MPI.MAX) for d, _ in found]
         which = int(np.argmax(depths))
         rank = comm.allreduce((found[which][0], comm.rank), op=MPI.MAXLOC)[1]
-        point = comm.bcast(found[which][1], root=rank)
+        point = np.asarray(comm.bcast(found[which][1], root=rank))
         inner, outer = ((target, striker), (striker, target))[which]
+        contact = _nearest_pair(problem, contacts, point)
         out.append(PairOverlap(contact.name, depths[which], float(contact.surface.h),
                                isinstance(contact, MortarContact), inner.name, outer.name,
-                               np.asarray(point)))
+                               point))
     return out
 
 
