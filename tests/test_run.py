@@ -324,3 +324,31 @@ def test_several_contacts_are_named_each_with_its_force(tmp_path, capsys):
     assert len(last) >= 2
     named = ", ".join(f"{name} {c['normal_force']:.6g}" for name, c in last.items())
     assert f"; contact forces {named}, max penetration" in line
+
+
+def test_a_support_that_drives_a_node_into_an_obstacle_is_named(tmp_path, capsys):
+    """The top of a block dragged 0.1 sideways into a wall 0.05 away.
+
+    The wall's candidate facets (the right side) include the top corner, which
+    the drag holds: past 0.05 the support pushes it into the wall. The run
+    stops at the step where that happens (the steps before are kept), and the
+    message names the cause and its fix; before, it named the penetration
+    only and advised method = "auto" and smaller steps, which cannot help.
+    """
+    scene = tmp_path / "dragged.toml"
+    scene.write_text(
+        '[scene]\nname = "dragged"\ndimension = 2\n\n'
+        '[mesh]\ngenerator = "rectangle"\norigin = [0.0, 0.0]\nsize = [1.0, 0.5]\n'
+        'cells = [10, 5]\n\n[material]\nlaw = "linear"\nE = 200.0\nnu = 0.3\n\n'
+        '[obstacle]\ntype = "plane"\npoint = [1.05, 0.0]\nnormal = [-1.0, 0.0]\n\n'
+        '[contact]\ntag = "right"\n\n'
+        '[[dirichlet]]\ntag = "bottom"\nvalue = [0.0, 0.0]\n\n'
+        '[[dirichlet]]\ntag = "top"\nvalue = [0.1, 0.0]\n\n'
+        '[solver]\nmethod = "gnrm"\nsteps = 4\nmax_cutbacks = 1\n')
+    assert main(["run", str(scene), "--out", str(tmp_path / "out"), "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert "at a node whose gap a [[dirichlet]] condition fixes: the prescribed displacement " \
+           "drives it into the partner" in err, err
+    assert "end that support's path before the contact" in err
+    assert "To try" not in err
+    assert "steps 1-2 are in" in err

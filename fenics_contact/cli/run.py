@@ -208,11 +208,14 @@ def _advice(scene: Scene, status: str, overlap: str | None = None, message: str 
     ``overlap``: the body's initial overlap with an obstacle, when it was warned
     about; first on the list, since no solver setting mends it. ``message``:
     the failed step's; when it already names the one fix (a node inside its
-    own self-contact neighbourhood), no solver setting is suggested.
+    own self-contact neighbourhood, a support that drives a node into its partner), no
+    solver setting is suggested.
     """
     if status not in ("cycling", "diverged", "max_iterations", "inverted"):
         return ""
-    if "cannot help: lower [[pair]] neighbourhood" in message:
+    from fenics_contact.solvers.diagnostics import NO_SOLVER_MENDS
+
+    if "cannot help: lower [[pair]] neighbourhood" in message or NO_SOLVER_MENDS in message:
         return "."
     method = scene.solver.method
     tips = []

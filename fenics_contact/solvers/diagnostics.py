@@ -259,6 +259,10 @@ def signorini_report(gap: np.ndarray, pressure: np.ndarray, comm) -> SignoriniRe
     )
 
 
+#: Said in a failure that no solver setting can mend (the CLI then suggests none).
+NO_SOLVER_MENDS = "which no solver can undo"
+
+
 def _first_violation(
     settings: SolverSettings,
     h: float,
@@ -319,12 +323,30 @@ def _signorini_violation(contact, settings: SolverSettings, E: float) -> str | N
     violation = _first_violation(
         settings, h, E, [("penetration", constraint)], [("tension", tension)]
     )
+    if violation is not None and violation.startswith("penetration") \
+            and _deepest_is_held(contact, state.gap):
+        violation += (" at a node whose gap a [[dirichlet]] condition fixes: the prescribed "
+                      f"displacement drives it into the partner, {NO_SOLVER_MENDS} (end that "
+                      "support's path before the contact, or leave the component along the "
+                      "contact normal free)")
     two_body = state.constraint_penetration is not None
     if violation is None and two_body and inside > settings.surface_tol * h:
         violation = (f"penetration into the target surface {inside:.3g} > surface_tol * h = "
                      f"{settings.surface_tol:g} * {h:.3g} "
                      f"({_inside_target_cause(contact, settings.surface_tol * h)})")
     return violation
+
+
+def _deepest_is_held(contact, gap: np.ndarray) -> bool:
+    """Whether the most penetrating node is one a prescribed displacement holds (collective)."""
+    from mpi4py import MPI
+
+    mask = contact.normal_mask
+    deepest = int(np.argmin(gap)) if gap.size else -1
+    local = float(-gap[deepest]) if gap.size else -np.inf
+    depth, rank = contact.comm.allreduce((local, contact.comm.rank), op=MPI.MAXLOC)
+    held = bool(mask is not None and deepest >= 0 and mask.x.array[deepest] < 0.5)
+    return bool(contact.comm.bcast(held, root=rank)) and depth > 0.0
 
 
 def _inside_target_cause(contact, depth: float) -> str:
