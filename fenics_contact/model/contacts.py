@@ -171,10 +171,23 @@ class Contact:
         self.interference.x.scatter_forward()
 
     def ramp_interference(self, t: float) -> None:
-        """The allowance at load factor t: 1 - t / interference_until, down to 0."""
-        if self.interference is not None:
-            until = float(self.settings.interference_until)  # type: ignore[arg-type]
-            self.allowance.value = max(1.0 - t / until, 0.0)
+        """The allowance at load factor t: 1 - t / interference_until, down to 0.
+
+        Up to interference_until, the step that ends there included, the
+        contact's friction is off (mu = 0): the closing fit stands for an
+        assembly whose path the scene does not model, and its normal motion
+        across faceted surfaces would read as slip. The load steps after it
+        slip from the assembled state with the contact's mu (a step that
+        starts before interference_until and ends after it closes the fit
+        with friction on: let a step end there).
+        """
+        if self.interference is None:
+            return
+        until = float(self.settings.interference_until)  # type: ignore[arg-type]
+        self.allowance.value = max(1.0 - t / until, 0.0)
+        if self.friction is not None and self.friction_settings is not None:
+            closing = t <= until * (1.0 + 1e-12)
+            self.friction.mu.value = 0.0 if closing else self.friction_settings.mu
 
     @property
     def ramping(self) -> bool:

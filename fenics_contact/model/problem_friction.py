@@ -44,7 +44,7 @@ class FrictionalContacts:
 
     def friction_coefficients(self) -> dict[str, float]:
         """Each frictional contact's mu by the contact's name (empty without friction)."""
-        return {c.name: float(c.friction.mu.value) for c in self.contacts
+        return {c.name: float(c.friction_settings.mu) for c in self.contacts
                 if c.friction is not None}
 
     def frictional_states(self) -> list:

@@ -512,7 +512,14 @@ def check_initial_overlap(scene: Scene, problem: ContactProblem) -> float:
             depth, warn_from = _mortar_depth(contact), 1e-3
         else:
             continue
-        deepest = max(deepest, _refuse_deep_overlap(scene, contact, depth, warn_from, limit))
+        depth_here = _refuse_deep_overlap(scene, contact, depth, warn_from, limit)
+        deepest = max(deepest, depth_here)
+        if fit is not None and depth_here <= 0.0:
+            warnings.warn(SceneWarning(
+                f"{scene.path.name}: [[pair]] {contact.name!r} gives interference_until, but "
+                "its surfaces start apart: there is no overlap to resolve and the key does "
+                "nothing. Check the interference in the mesh (its sign), or remove the key."),
+                stacklevel=2)
     return deepest
 
 

@@ -207,11 +207,11 @@ def _interference_until(reader: _Reader) -> float | None:
     """[[pair]] interference_until: a load factor in (0, 1], or None (absent)."""
     if "interference_until" not in reader.table:
         return None
-    value = reader.number("interference_until", positive=True)
-    if value > 1.0:
+    value = reader.number("interference_until")
+    if not 0.0 < value <= 1.0:
         raise reader.fail("interference_until", "is the load factor by which the starting "
                           "overlap is resolved: give a number in (0, 1] (1: over the whole "
-                          "load path).")
+                          "load path), or leave the key out to resolve it by the first step.")
     return value
 
 
