@@ -95,6 +95,18 @@ def test_wrong_dimension_of_a_gmsh_mesh_is_reported(tmp_path):
         build_problem(scene)
 
 
+def _with_geo(tmp_path: Path, name: str, old: str, new: str) -> Path:
+    """The shipped scene ``name`` on a copy of its .geo with ``old`` replaced by ``new``."""
+    shipped = Path(__file__).parents[1] / "scenes" / f"{name}.toml"
+    geo = (shipped.parents[1] / "meshes" / f"{name}.geo").read_text()
+    assert old in geo
+    (tmp_path / f"{name}.geo").write_text(geo.replace(old, new))
+    scene_file = tmp_path / f"{name}.toml"
+    scene_file.write_text(shipped.read_text().replace(f'"../meshes/{name}.geo"',
+                                                      f'"{tmp_path}/{name}.geo"'))
+    return scene_file
+
+
 def test_shipped_scenes_are_valid():
     names = set()
     for path in sorted(SCENES.glob("*.toml")):
@@ -170,14 +182,7 @@ def test_a_geo_parameter_under_another_onelab_path_is_named(tmp_path):
     from fenics_contact.scene.build import build_mesh
     from fenics_contact.scene.schema import SceneError, load_scene
 
-    shipped = Path(__file__).parents[1] / "scenes" / "hertz_cylinder.toml"
-    geo = (shipped.parents[1] / "meshes" / "hertz_cylinder.geo").read_text()
-    moved = geo.replace('Name "Parameters/', 'Name "P/')
-    assert moved != geo
-    (tmp_path / "moved.geo").write_text(moved)
-    scene_file = tmp_path / "moved.toml"
-    scene_file.write_text(shipped.read_text().replace('"../meshes/hertz_cylinder.geo"',
-                                                      f'"{tmp_path}/moved.geo"'))
+    scene_file = _with_geo(tmp_path, "hertz_cylinder", 'Name "Parameters/', 'Name "P/')
     with pytest.raises(SceneError, match=r"'h_contact' is declared with Name 'P/h_contact'; "
                        r"only names under \"Parameters/\" can be set from a scene: Name "
                        r"\"Parameters/h_contact\""):
@@ -214,16 +219,9 @@ def test_overlapping_physical_groups_are_refused_before_meshing(tmp_path):
     from fenics_contact.scene.build import build_mesh
     from fenics_contact.scene.schema import SceneError, load_scene
 
-    shipped = Path(__file__).parents[1] / "scenes" / "bridge.toml"
-    geo = (shipped.parents[1] / "meshes" / "bridge.geo").read_text()
-    overlapping = geo.replace('Physical Curve("bridge_top", 9) = {26};',
-                              'Physical Curve("bridge_top", 9) = {26};\n'
-                              'Physical Curve("bridge_ends", 10) = {25, 26, 27};')
-    assert overlapping != geo
-    (tmp_path / "bridge.geo").write_text(overlapping)
-    scene_file = tmp_path / "bridge.toml"
-    scene_file.write_text(shipped.read_text().replace('"../meshes/bridge.geo"',
-                                                      f'"{tmp_path}/bridge.geo"'))
+    scene_file = _with_geo(tmp_path, "bridge", 'Physical Curve("bridge_top", 9) = {26};',
+                           'Physical Curve("bridge_top", 9) = {26};\n'
+                           'Physical Curve("bridge_ends", 10) = {25, 26, 27};')
     with pytest.raises(SceneError, match=r"bridge.geo: Curve 26 of the mesh file is in two "
                                          r"physical groups, 'bridge_top' and 'bridge_ends'.*"
                                          r"Make the groups disjoint"):
