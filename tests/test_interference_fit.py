@@ -16,6 +16,7 @@ does not reach).
 
 from __future__ import annotations
 
+import dataclasses
 import tomllib
 from pathlib import Path
 
@@ -113,6 +114,15 @@ def test_friction_waits_for_the_fit_to_close():
                                                discretisation="node-to-segment"))
     assert means == pytest.approx(plain, rel=1e-9)
     assert np.allclose(last, plain_last, rtol=1e-6)  # Newton tolerance (1e-8 measured)
+
+
+def test_a_frictional_fit_whose_steps_jump_past_its_end_is_warned():
+    """interference_until = 0.5 in 3 steps: the second one closes the fit with friction on."""
+    scene = _scene(mu=0.3, interference_until=0.5, discretisation="node-to-segment")
+    scene = dataclasses.replace(scene, solver=dataclasses.replace(scene.solver, steps=3))
+    with pytest.warns(SceneWarning, match=r"no load step ends at interference_until = 0.5 "
+                      r"\(the steps end at 0.3333, 0.6667, 1\)"):
+        build_problem(scene)
 
 
 @pytest.mark.parametrize("value", [0.0, 1.5, "soon"])

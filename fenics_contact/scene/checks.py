@@ -514,6 +514,8 @@ def check_initial_overlap(scene: Scene, problem: ContactProblem) -> float:
             continue
         depth_here = _refuse_deep_overlap(scene, contact, depth, warn_from, limit)
         deepest = max(deepest, depth_here)
+        if fit is not None and contact.friction_settings is not None:
+            _warn_fit_between_steps(scene, contact)
         if fit is not None and depth_here <= 0.0:
             warnings.warn(SceneWarning(
                 f"{scene.path.name}: [[pair]] {contact.name!r} gives interference_until, but "
@@ -521,6 +523,21 @@ def check_initial_overlap(scene: Scene, problem: ContactProblem) -> float:
                 "nothing. Check the interference in the mesh (its sign), or remove the key."),
                 stacklevel=2)
     return deepest
+
+
+def _warn_fit_between_steps(scene: Scene, contact) -> None:
+    """Warn when no load step of a frictional fit ends at its interference_until."""
+    until = float(contact.settings.interference_until)
+    steps = int(scene.solver.steps)
+    if abs(until * steps - round(until * steps)) <= 1e-9:
+        return
+    ends = ", ".join(f"{k / steps:.4g}" for k in range(1, min(steps, 6) + 1))
+    warnings.warn(SceneWarning(
+        f"{scene.path.name}: [[pair]] {contact.name!r}: no load step ends at "
+        f"interference_until = {until:g} (the steps end at {ends}"
+        f"{', ...' if steps > 6 else ''}): the step across it closes the rest of the fit "
+        "with friction on. Choose [solver] steps so that one ends there (friction acts from "
+        "the assembled state)."), stacklevel=3)
 
 
 #: A mortar interference fit may start this fraction of the segment search's reach deep.
