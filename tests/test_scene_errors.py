@@ -124,6 +124,8 @@ SCHEMA_CASES = [
     ("tag-type", edit(contact__tag=1.5), r"\[contact\] tag = 1.5: give a facet tag number or a"),
     ("unknown-key", edit(solver__stpes=3), r"unknown key 'stpes'.*Did you mean 'steps'"),
     ("unknown-top", edit(solvers={"steps": 1}), r"unknown key 'solvers' at top level"),
+    ("key-of-another-block", edit(contact__interference_until=1.0),
+     r"unknown key 'interference_until' at \[contact\]\. It belongs to \[\[pair\]\]\."),
     ("table-missing", edit(material=None), r"the \[material\] table is missing; add it"),
     ("table-type", edit(obstacle=[1, 2]), r"\[obstacle\] must be a table or \[\[obstacle"),
     ("table-type-solver", edit(solver=[1, 2]), r"\[solver\] must be a table, not list"),

@@ -128,6 +128,11 @@ class _Reader:
         return value
 
 
+#: How messages write the sections that are arrays of tables.
+_ARRAYS = {"pair": "[[pair]]", "body": "[[body]]", "dirichlet": "[[dirichlet]]",
+           "traction": "[[traction]]", "obstacles": "[[obstacle]]"}
+
+
 def _check_keys(path: Path, section: str, table: dict[str, Any],
                 where: str | None = None) -> None:
     """Refuse a key the section does not know; ``where`` names the block (else the section)."""
@@ -136,6 +141,10 @@ def _check_keys(path: Path, section: str, table: dict[str, Any],
         if key not in allowed:
             close = difflib.get_close_matches(key, sorted(allowed), n=1)
             hint = f" Did you mean {close[0]!r}?" if close else ""
+            elsewhere = [other for other, keys in KEYS.items() if other and key in keys]
+            if not close and elsewhere:
+                hint = " It belongs to " + " or ".join(
+                    _ARRAYS.get(o, f"[{o}]") for o in elsewhere) + "."
             where = where or (f"[{section}]" if section else "top level")
             raise SceneError(
                 f"{path.name}: unknown key {key!r} at {where}.{hint} "
