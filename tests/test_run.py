@@ -352,3 +352,7 @@ def test_a_support_that_drives_a_node_into_an_obstacle_is_named(tmp_path, capsys
     assert "end that support's path before the contact" in err
     assert "To try" not in err
     assert "steps 1-2 are in" in err
+    last = json.loads((tmp_path / "out" / "summary.json").read_text())["steps"][-1]
+    # the state it stopped in, and the load factor of its last attempt
+    assert (last["load_factor"], last["failed_at"]) == (0.5, 0.625)
+    assert "at load factor 0.625" in last["message"]

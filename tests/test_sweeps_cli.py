@@ -38,7 +38,11 @@ def test_tradeoff_command_on_a_scene_writes_json_csv_table_and_plot(tmp_path):
     assert status[("auto", 1e10)] == "converged" and status[("gnrm", 1e10)] != "converged"
     assert any(r["pareto_u"] == "True" for r in rows)
     assert len(json.loads((tmp_path / "tradeoff.json").read_text())) == 4
-    assert "| bar | paper_ex2 | Auto |" in (tmp_path / "table.md").read_text()
+    table = (tmp_path / "table.md").read_text()
+    assert "| bar | paper_ex2 | Auto |" in table
+    # GNRM converged at r = 1 E/h only: the reference's own point, and marked so
+    gnrm = next(line for line in table.splitlines() if "| GNRM |" in line)
+    assert "(the reference's own method and r)" in gnrm
     assert (tmp_path / "tradeoff.png").stat().st_size > 10_000
 
 
@@ -158,3 +162,28 @@ def test_sweeps_on_a_frictional_scene_with_several_contacts(tmp_path):
     assert float(row["ft_ratio"]) == pytest.approx(
         wall["tangential_force"] / (0.2 * wall["normal_force"]), rel=1e-12)
     assert float(row["ft_ratio"]) == pytest.approx(0.98138, abs=1e-4)
+
+
+@pytest.mark.parametrize("contact_set", ["sign", "exact"])
+def test_stability_counts_match_run_with_the_same_contact_set(tmp_path, contact_set):
+    """The help's promise: `run` with predictor "previous" and the same contact set.
+
+    Before, the sweeps always took the sign rule, while a scene's default is
+    the exact set: a user's 3D quarter model read "diverged" at r = 1e4 E/h
+    where `run` converged in 10 iterations. --contact-set chooses.
+    """
+    text = (SCENES / "hertz_cylinder.toml").read_text()
+    assert 'method = "gnrm"' in text
+    text = text.replace('method = "gnrm"', f'method = "gnrm"\npredictor = "previous"\n'
+                        f'contact_set = "{contact_set}"')
+    text = text.replace('"../meshes/', f'"{SCENES.parent / "meshes"}/')
+    scene = tmp_path / "hertz.toml"
+    scene.write_text(text)
+    assert main(["run", str(scene), "--out", str(tmp_path / "run"), "--quiet"]) == 0
+    run = json.loads((tmp_path / "run" / "summary.json").read_text())
+    code = main(["stability", str(scene), "--methods", "gnrm", "--r", "1",
+                 "--contact-set", contact_set, "--out", str(tmp_path / "stab")])
+    assert code == 0
+    (row,) = read_csv(tmp_path / "stab" / "stability.csv")
+    assert row["status"] == "converged"
+    assert int(row["iterations"]) == sum(s["iterations"] for s in run["steps"])

@@ -8,6 +8,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from fenics_contact.cli.progress import progress_to_csv
+from fenics_contact.cli.stability import add_contact_set_option
 from fenics_contact.cli.study import floats, methods
 
 
@@ -34,7 +35,7 @@ def tradeoff_and_write(cases: Sequence, args: argparse.Namespace) -> int:
     _, show = progress_to_csv(out / "tradeoff.csv", line)
     records = run_tradeoff(
         cases, args.methods, args.r, progress=show, repeats=args.repeats,
-        max_iterations=args.max_iterations,
+        max_iterations=args.max_iterations, contact_set=args.contact_set,
     )
     table = markdown_table(records)
     if rank0:
@@ -61,6 +62,7 @@ def add_tradeoff_options(cmd: argparse.ArgumentParser, default_out: Path) -> Non
                      help="timed repeats of a converged run; the median is kept (default 3)")
     cmd.add_argument("--max-iterations", type=int, default=200,
                      help="Newton iteration cap per load step (default 200)")
+    add_contact_set_option(cmd)
     cmd.add_argument("--out", type=Path, default=default_out, help="output folder")
 
 
@@ -86,7 +88,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "Pareto front marked). The project's own trade-off (Hertz, the Example 2 bar, the "
         "sliding block with friction, three meshes each) is benchmarks/research/tradeoff.py."
         " Each load step starts from the last converged state (predictor \"previous\", "
-        "whatever the scene says), so that every method starts alike; its stopping "
+        "whatever the scene says), so that every method starts alike, each Newton step "
+        "takes its contact set by the sign rule unless --contact-set exact; its stopping "
         "tolerance is its own (tighter than a scene's, to measure the error), so iteration "
         "counts may exceed those of `run` with predictor = \"previous\" by one or two.",
     )

@@ -59,6 +59,8 @@ class StepRecord:
             undeformed; <= 0 means inverted elements).
         worst_cell: reference midpoint of the cell holding ``min_det_F``.
         message: why the step failed (empty when it converged).
+        failed_at: the load factor of a failed step's last attempt (None when
+            it converged); ``load_factor`` is then the state it stopped in.
         tangential_force: magnitude of the total tangential contact force
             (force, per thickness in 2D; 0 without friction).
         stick_count: contact nodes that stick (0 without friction).
@@ -97,6 +99,7 @@ class StepRecord:
     contacts: dict[str, dict] = field(default_factory=dict)
     reactions: dict[str, list[float]] = field(default_factory=dict)
     reaction_total: list[float] = field(default_factory=list)
+    failed_at: float | None = None
 
     def to_dict(self) -> dict:
         """Plain-data view for JSON."""
@@ -416,6 +419,7 @@ def solve_load_path(
             if halvings > max_cutbacks or increment / 2 < smallest * (1 - 1e-12):
                 step.status = status.value
                 step.load_factor = t
+                step.failed_at = t_try
                 step.message = _failure_message(step, t_try, refused, earlier)
                 _settle(strategy, t)
                 break

@@ -166,10 +166,15 @@ def run_case(
     max_iterations: int = 100,
     max_cutbacks: int = 0,
     force_rtol: float = DEFAULT_FORCE_RTOL,
+    contact_set: str = "sign",
     out: Path | None = None,
     comm: MPI.Comm = MPI.COMM_WORLD,
 ) -> CaseRecord:
-    """Run one method on one case; never raises for a solver or model failure."""
+    """Run one method on one case; never raises for a solver or model failure.
+
+    ``contact_set``: how each Newton step chooses its contact set ("sign",
+    the paper's GNRM, or "exact", a scene's default; see make_strategy).
+    """
     scene = case.scene
     record = CaseRecord(
         status=ERROR, method=method, r_relative=case.r, r_absolute=0.0, case=case.name,
@@ -192,7 +197,8 @@ def run_case(
         record.mus = problem.friction_coefficients() if problem.frictional else {}
         atol = scaled_atol(problem, force_rtol)
         strategy = make_strategy(
-            method, problem, SolverSettings(atol=atol, max_iterations=max_iterations)
+            method, problem, SolverSettings(atol=atol, max_iterations=max_iterations),
+            contact_set=contact_set,
         )
         record = CaseRecord(
             **{**vars(start_record(strategy)), **_case_fields(record)}, atol=atol
