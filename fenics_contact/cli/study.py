@@ -140,8 +140,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "(residual histories, iterations against r). The paper's Tables 1 and 2 beside "
         "the published ones: benchmarks/research/paper_tables.py (make paper-tables)."
         " Each load step starts from the last converged state (predictor \"previous\", "
-        "whatever the scene says), so that every method starts alike: iteration counts "
-        "match `run` with predictor = \"previous\".",
+        "whatever the scene says), so that every method starts alike, and each Newton "
+        "step takes its contact set by the sign rule, as the paper's GNRM: iteration "
+        "counts match `run` with predictor = \"previous\" and contact_set = \"sign\".",
     )
     study.add_argument("scene", type=Path, help="the scene file (.toml)")
     study.add_argument(
