@@ -31,6 +31,7 @@ from fenics_contact.scene.checks import warn_untagged_penetration
 from fenics_contact.scene.pressure_scatter import warn_pressure_scatter
 from fenics_contact.scene.schema import Scene
 from fenics_contact.scene.self_overlap import warn_self_overlap
+from fenics_contact.scene.slot_overflow import warn_slot_overflow, warn_slots_capped
 from fenics_contact.scene.striker_advice import advise_striker
 from fenics_contact.scene.unpaired_overlap import warn_unpaired_overlap
 from fenics_contact.solvers import make_strategy
@@ -311,6 +312,7 @@ def run_scene(
     with _kept(notes):
         problem = build_problem(scene, comm)
         _warn_loose_tolerance(scene, problem)
+        warn_slots_capped(problem)
     used = contact_settings(problem)
     strategy = scene_strategy(scene, problem, on_residual)
     saved = restore(out / "checkpoint", problem, marker) if marker is not None else None
@@ -364,6 +366,8 @@ def run_scene(
         # the failed step's record holds the state the run stopped in (restored)
         path.steps[-1].reactions = problem.support_reactions()
         path.steps[-1].reaction_total = problem.support_total()
+    with _kept(notes):
+        warn_slot_overflow(problem)  # also when no step converged: it may be why
     if any(s.status == "converged" for s in path.steps):
         # checks of the answer; with no load step finished the state is the start,
         # which the checks before the first step have described

@@ -102,6 +102,7 @@ def _solve(
     from mpi4py import MPI
 
     from fenics_contact.runner import run_scene
+    from fenics_contact.scene.slot_overflow import slot_shortfall
 
     steps = scene.solver.steps
     quiet = args.quiet or MPI.COMM_WORLD.rank != 0
@@ -140,10 +141,11 @@ def _solve(
     path = outcome.path
     if not path.converged:
         failed = path.steps[-1]
+        slots = slot_shortfall(outcome.problem)  # collective
         if MPI.COMM_WORLD.rank == 0:  # the same on every process: said once
             advice = _advice(scene, failed.status,
                              getattr(outcome.problem, "initial_overlap", None),
-                             failed.message or "")
+                             failed.message or "", slots)
             print(f"fenics-contact: load step {failed.step} of {steps} did not converge "
                   f"({failed.message or failed.status}); {_kept(failed.step - 1, out)}"
                   f"{advice}", file=sys.stderr)
@@ -202,14 +204,17 @@ def _count(n: int, noun: str) -> str:
     return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
 
 
-def _advice(scene: Scene, status: str, overlap: str | None = None, message: str = "") -> str:
+def _advice(scene: Scene, status: str, overlap: str | None = None, message: str = "",
+            slots: str | None = None) -> str:
     """What to try after a failed load step (nothing for a stop that is not the solver's).
 
     ``overlap``: the body's initial overlap with an obstacle, when it was warned
     about; first on the list, since no solver setting mends it. ``message``:
     the failed step's; when it already names the one fix (a node inside its
     own self-contact neighbourhood, a support that drives a node into its partner), no
-    solver setting is suggested.
+    solver setting is suggested. ``slots``: a 2D mortar pair whose nodes overlapped
+    more target facets than their slots (:func:`~fenics_contact.scene.slot_overflow.
+    slot_shortfall`); first on the list, since its weighted gaps jump.
     """
     if status not in ("cycling", "diverged", "max_iterations", "inverted"):
         return ""
@@ -222,6 +227,8 @@ def _advice(scene: Scene, status: str, overlap: str | None = None, message: str 
     if overlap:
         tips.append(f"first the start: {overlap}; place the obstacle so that the gap at "
                     "load 0 is >= 0")
+    if slots:
+        tips.append(f"first the slots: {slots}")
     if status == "max_iterations" and method in ("nua", "sua"):
         tips.append(f"a larger [solver] max_iterations (now {scene.solver.max_iterations}: "
                     f"{method.upper()} counts every multiplier update as an iteration and "

@@ -12,6 +12,8 @@ conventions as in :mod:`.contact`.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 import ufl
 from dolfinx import default_scalar_type, fem, mesh
@@ -30,6 +32,22 @@ from fenics_contact.model.friction import FrictionSettings
 from fenics_contact.model.friction_terms import CoulombFriction
 from fenics_contact.model.state import ContactState
 
+
+class SlotUse(NamedTuple):
+    """The target facets each striker node of a 2D mortar pair may see (its slots).
+
+    ``wanted``: what a striker support overlaps where the surfaces first meet
+    (chosen at the start); ``now`` and ``most``: the most target facets one
+    striker node in contact overlapped, in the current state and at any
+    search of the run. Beyond ``slots`` the weighted gap leaves the rest of
+    the support out.
+    """
+
+    contact: str
+    slots: int
+    wanted: int
+    now: int
+    most: int
 
 class Contact:
     """A candidate contact surface of the solid against a partner, with optional friction.
@@ -276,6 +294,10 @@ class Contact:
         peak = self.comm.allreduce(float(np.max(-pressure, initial=0.0)), op=MPI.MAX)
         pressure[pressure > -max(1e-12 * peak, 1e-14 * self.modulus)] = 0.0
         return pressure
+
+    def slot_use(self) -> SlotUse | None:
+        """A 2D mortar pair's slots and how many target facets its nodes overlapped; else None."""
+        return None
 
     def reported(self, values: np.ndarray) -> np.ndarray:
         """Owned nodal values as written and measured (pressure, traction, Coulomb limit).

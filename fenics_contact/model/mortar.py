@@ -38,14 +38,14 @@ from dolfinx import default_scalar_type, fem, la
 from mpi4py import MPI
 
 from fenics_contact.model.contact import ContactSettings, ContactSurface, assemble_local
-from fenics_contact.model.contacts import Contact
+from fenics_contact.model.contacts import Contact, SlotUse
 from fenics_contact.model.friction import FrictionSettings
 from fenics_contact.model.search import penetration_depth
 from fenics_contact.model.segments import (
+    MOST_SLOTS,
     NEAR,
     OPPOSING,
     REACH,
-    SLOTS,
     Polyline,
     any_rank,
     facet_sizes,
@@ -53,6 +53,7 @@ from fenics_contact.model.segments import (
     node_blocks,
     overlaps,
     pick_slots,
+    slots_needed,
 )
 from fenics_contact.model.variational_system import Transfers
 
@@ -95,7 +96,10 @@ class MortarTransfer:
             raise ValueError("A striker node of a mortar pair has no striker facet.")
         self.sides = (left, right)
         self._idx = np.stack([np.where(nb >= 0, nb, self.me) for nb in self.sides], axis=1)
-        self.slots = int(SLOTS if slots is None else slots)
+        #: Target facets a support needs where the surfaces first meet (:func:`slots_needed`).
+        self.slots_wanted = int(self.comm.allreduce(slots_needed(self.striker, self.target),
+                                                    op=MPI.MAX))
+        self.slots = int(min(self.slots_wanted, MOST_SLOTS) if slots is None else slots)
         self.striker_size = float(np.max(facet_sizes(self.striker)))
         self.reach = REACH * max(self.striker_size, float(np.max(facet_sizes(self.target))))
         self.rows = 2 + 2 * self.slots
@@ -123,6 +127,10 @@ class MortarTransfer:
         self.version = 0
         self.search_count = 0
         self.overflow = 0
+        #: The most target facets one striker node near contact overlapped: at the last
+        #: search, and at any search so far (owned nodes, this rank).
+        self.overlaps_now = 0
+        self.most_overlaps = 0
         self._searched_u: np.ndarray | None = None
 
     def refresh(self) -> bool:
@@ -138,6 +146,9 @@ class MortarTransfer:
         #: Striker nodes near contact (target within NEAR facet lengths) that overlap more
         #: target facets than there are slots (owned, this rank); 0 in every test.
         self.overflow = int(np.sum(((dropped > 0) & near)[: self.n_owned]))
+        counts = np.sum(scores > 0.0, axis=1)[: self.n_owned][near[: self.n_owned]]
+        self.overlaps_now = int(counts.max(initial=0))
+        self.most_overlaps = max(self.most_overlaps, self.overlaps_now)
         self.search_count += 1
         self._picked = (facet, used)
         fv = self.target.facet_vertex
@@ -376,6 +387,15 @@ class MortarContact(Contact):
         from fenics_contact.model.mortar3d import ENGAGED
 
         return gaps <= ENGAGED * self.mortar.open_gap
+
+    def slot_use(self) -> SlotUse | None:
+        """2D: the slots and the most target facets a striker node overlapped (collective)."""
+        if self.gdim == 3:
+            return None
+        m = self.mortar
+        wanted, now, most = (int(self.comm.allreduce(v, op=MPI.MAX))
+                             for v in (m.slots_wanted, m.overlaps_now, m.most_overlaps))
+        return SlotUse(self.name, m.slots, wanted, now, most)
 
     def reported(self, values: np.ndarray) -> np.ndarray:
         """2D: the nodal force per tributary length of the multiplier field (stress).

@@ -441,6 +441,10 @@ class ContactProblem(FrictionalContacts):
 
         return balls_passed_through(self.V, self.u, self.contacts)
 
+    def slot_uses(self) -> list:
+        """Each 2D mortar pair's :class:`~.contacts.SlotUse` (collective)."""
+        return [use for c in self.contacts if (use := c.slot_use()) is not None]
+
     def target_force(self) -> fem.Function:
         """Force the strikers put on their targets' vertices, summed over the pairs (force).
 

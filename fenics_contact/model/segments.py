@@ -30,8 +30,13 @@ from mpi4py import MPI
 REACH = 2.0
 #: A node whose target lies within this many facet lengths counts as near contact.
 NEAR = 0.25
-#: Slots per striker node unless the pair says otherwise.
+#: Slots per striker node at least (more where the target is finer than the striker).
 SLOTS = 4
+#: Slots per striker node at most when chosen from the facet sizes (compile time grows
+#: with them); a pair may ask for more (``[[pair]] slots``).
+MOST_SLOTS = 12
+#: Stretch allowed for when counting the target facets a striker support may overlap.
+STRETCH = 1.25
 #: Lowest cosine of the angle between the striker normal and minus the target normal.
 OPPOSING = 0.2
 #: A target facet whose projection misses a striker facet by up to this (local coordinate)
@@ -213,6 +218,63 @@ def facet_sizes(line: Polyline) -> np.ndarray:
     """Reference length of each facet of a polyline."""
     X = line.X[line.facet_vertex]
     return np.linalg.norm(X[:, 1] - X[:, 0], axis=-1)
+
+
+def slots_needed(striker: Polyline, target: Polyline, stretch: float = STRETCH) -> int:
+    """Target facets the support of a striker node may overlap where the surfaces meet.
+
+    For every striker node whose distance to the target exceeds the
+    surfaces' closest approach by at most its support length (the nodes
+    where the surfaces first meet), the target facets within half its
+    support length (times ``stretch``) of a target vertex near its closest
+    point are counted; the largest count is returned (at least
+    :data:`SLOTS`). Where the meshes change along the surfaces beyond that
+    zone, :attr:`MortarTransfer.most_overlaps` tells afterwards. A coarse striker facet over
+    a fine target needs more than the default slots: with too few, the
+    weighted gap would leave part of the support out and jump as the facets
+    it keeps change. Reference configuration; the same on every rank (both
+    polylines are gathered).
+    """
+    from scipy.spatial import cKDTree
+
+    if not (striker.facet_vertex.size and target.facet_vertex.size):
+        return SLOTS
+    xs, xt = striker.X, target.X
+    ends = xt[target.facet_vertex]
+    ls = facet_sizes(striker)
+    support = np.zeros(len(xs))
+    np.add.at(support, striker.facet_vertex[:, 0], ls)
+    np.add.at(support, striker.facet_vertex[:, 1], ls)
+    # closest point of each striker node on the target polyline
+    a, b = ends[:, 0], ends[:, 1]
+    ab = b - a
+    tree = cKDTree(0.5 * (a + b))
+    extent = float(np.linalg.norm(np.ptp(np.vstack([xs, xt]), axis=0)))
+    longest = float(np.max(np.linalg.norm(ab, axis=1)))
+    _, nearest = tree.query(xs, k=min(8, len(ab)))
+    nearest = np.atleast_2d(nearest.T).T
+    d = xs[:, None] - a[nearest]
+    s = np.clip(np.einsum("nki,nki->nk", d, ab[nearest])
+                / np.einsum("nki,nki->nk", ab[nearest], ab[nearest]), 0.0, 1.0)
+    foot = a[nearest] + s[..., None] * ab[nearest]
+    dist = np.linalg.norm(xs[:, None] - foot, axis=-1)
+    best = np.argmin(dist, axis=1)
+    closest = foot[np.arange(len(xs)), best]
+    gap = dist[np.arange(len(xs)), best]
+    vertices = cKDTree(xt)
+    most = SLOTS
+    for j in np.flatnonzero(gap <= gap.min() + support):
+        radius = 0.5 * stretch * support[j]
+        centres = xt[vertices.query_ball_point(closest[j], radius + 1e-12 * extent)]
+        if not len(centres):
+            continue
+        near = tree.query_ball_point(closest[j], 2.0 * radius + longest)
+        pa, pab = a[near], ab[near]
+        t = np.clip(np.einsum("cki,ki->ck", centres[:, None] - pa, pab)
+                    / np.einsum("ki,ki->k", pab, pab), 0.0, 1.0)
+        reach = np.linalg.norm(centres[:, None] - (pa + t[..., None] * pab), axis=-1)
+        most = max(most, int(np.max(np.sum(reach < radius, axis=1))))
+    return most
 
 
 def any_rank(comm: MPI.Comm, flag: bool) -> bool:

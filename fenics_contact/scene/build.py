@@ -372,7 +372,7 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
                                    interference_until=pair.interference_until)
         if pair.discretisation == "mortar":
             contacts.append(MortarContact(striker, target, settings, friction=friction,
-                                          name=pair.name))
+                                          name=pair.name, slots=pair.slots))
             continue
         contacts.append(NodeToSegmentContact(
             striker, target, settings,

@@ -179,6 +179,7 @@ def read_pairs(path: Path, data: dict[str, Any], dimension: int = 2) -> tuple[Pa
             neighbourhood=reader.number("neighbourhood", 3.0, positive=True),
             discretisation=_discretisation(reader, dimension, two_surfaces),
             interference_until=_interference_until(reader),
+            slots=_slots(reader, dimension),
         ))
     _refuse_repeated_surfaces(path, out)
     return tuple(out)
@@ -213,6 +214,19 @@ def _interference_until(reader: _Reader) -> float | None:
                           "overlap is resolved: give a number in (0, 1] (1: over the whole "
                           "load path), or leave the key out to resolve it by the first step.")
     return value
+
+
+def _slots(reader: _Reader, dimension: int) -> int | None:
+    """[[pair]] slots: target facets a 2D mortar striker node may see; None: from the meshes."""
+    if "slots" not in reader.table:
+        return None
+    if reader.table.get("discretisation") != "mortar" or dimension != 2:
+        raise reader.fail("slots", "is the number of target facets a striker node of a 2D "
+                          'mortar pair may see: it needs discretisation = "mortar" in a 2D '
+                          "scene; remove it here.")
+    return reader.integer("slots", 4, minimum=2, maximum=32,
+                          why="each slot adds to the compiled forms; refine the striker "
+                          "surface instead.")
 
 
 def _discretisation(reader: _Reader, dim: int, two_surfaces: bool) -> str:

@@ -227,6 +227,11 @@ KEY_DOCS: dict[str, dict[str, KeyDoc]] = {
                                      "the overlap is resolved in proportion to the load factor "
                                      "until this one (absent: by the first load step).", "",
                                      "absent", field="PairSpec.interference_until"),
+        "slots": KeyDoc("integer in [2, 32]", "2D mortar: how many target facets one "
+                        "striker node's two facets may overlap (a coarse striker over a fine "
+                        "target needs more; the run warns when a node overlapped more).", "",
+                        "from the facet sizes where the surfaces first meet (at least 4, "
+                        "at most 12)", field="PairSpec.slots"),
     },
     "pairing": {
         "automatic": KeyDoc("boolean", "Pair every body's exterior surface with every other "

@@ -90,6 +90,8 @@ class PairSpec:
     discretisation: str = "node-to-segment"
     #: Load factor by which a starting overlap (an interference fit) is resolved; None: at once.
     interference_until: float | None = None
+    #: 2D mortar: target facets a striker node may see; None: chosen from the facet sizes.
+    slots: int | None = None
 
 
 @dataclass(frozen=True)
