@@ -177,3 +177,31 @@ def test_auto_fallback_kernels_use_the_configured_linear_solver():
     assert strategy.kernel.linear.kind == "iterative"
     assert strategy._penalty.linear.kind == "iterative"
     assert strategy._penalty.ksp.getType() == "gmres"
+
+
+def test_auto_at_huge_r_under_the_scenes_predictor_gives_the_r_1_answer(tmp_path):
+    """The active-set predictor imposes its set for the r auto works at, not the user's.
+
+    At r = 1e12 E/h the set used to be imposed with lam = -r g at the user's
+    r (1e15 here): multipliers of r g's round-off, a first residual of 1e12
+    that the relative test (1e-10 of it) let pass after one iteration, and
+    a Newton polish at the user's r. The two cylinders then read forces up
+    to 2.6e-4 from the r = 1 E/h answer with supports 1.2e-8 out of
+    balance; a user's grazing mortar pair was accepted with a contact force
+    of 0 while its supports carried 0.8. Now each step is the r = 1 answer.
+    """
+    from pathlib import Path
+
+    from fenics_contact.runner import run_scene
+    from fenics_contact.scene.schema import load_scene
+    from fenics_contact.scene.variants import with_contact_settings, with_solver
+
+    scene = load_scene(Path(__file__).resolve().parents[1] / "scenes"
+                       / "two_cylinders_node_to_segment.toml")
+    reference = run_scene(scene, tmp_path / "r1", pictures=False).path.steps
+    huge = with_solver(with_contact_settings(scene, r=1e12, relative=True), method="auto")
+    steps = run_scene(huge, tmp_path / "huge", pictures=False).path.steps
+    assert [s.status for s in steps] == ["converged"] * len(reference)
+    for ours, ref in zip(steps, reference, strict=True):
+        assert abs(ours.contact_force - ref.contact_force) <= 1e-8 * ref.contact_force
+        assert max(abs(f) for f in ours.reaction_total) <= 1e-10

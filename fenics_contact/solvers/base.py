@@ -64,6 +64,10 @@ class Strategy(Protocol):
         """Solve at the problem's current load, starting from its current state."""
         ...
 
+    def working_r(self) -> float:
+        """The first contact's r the solve works at (absolute; the problem's unless rescaled)."""
+        ...
+
 
 def newton_loop(
     kernel: NewtonKernel,
@@ -235,6 +239,10 @@ class NewtonStrategy:
             admissible=admissibility(self.problem, settings,
                                      exact_constraint=self.exact_constraint),
         )
+
+    def working_r(self) -> float:
+        """The first contact's r the solve works at: the problem's (absolute)."""
+        return self.problem.r_absolute
 
     def residual_norm(self) -> float:
         """The norm the stopping test reads (default: the kernel's residual)."""

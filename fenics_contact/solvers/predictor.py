@@ -252,6 +252,9 @@ class ActiveSetPredicted(Extrapolated):
         offsets = self._offsets()
         p = 1.0 / self.edge_exponent
         comm = self.problem.comm
+        # the set is imposed for the r the solve works at (auto rescales a huge user r):
+        # lam = -r g at the user's r = 1e16 E/h is r g's round-off, not a pressure
+        at_work = self.inner.working_r() / self.problem.r_absolute
         for k, (c, g_pred) in enumerate(zip(self._chosen(), self._nodal_gaps(), strict=True)):
             n = g_pred.size
             start = offsets[id(c)]
@@ -270,7 +273,7 @@ class ActiveSetPredicted(Extrapolated):
             floor = self.margin * scale  # a pressure below this is round-off (an open node)
             was_active = last < -floor
             active = np.where(was_active, lam < 0.0, closing)
-            r = float(c.r.value)
+            r = float(c.r.value) * at_work
             tiny = self.margin * max(scale, 1e-6 * r * c.surface.h)
             augmented = lam + r * g_pred
             to_close = active & (augmented >= -tiny)
@@ -293,11 +296,12 @@ class ActiveSetPredicted(Extrapolated):
         every node within 1e-12 h of it.
         """
         comm = self.problem.comm
+        at_work = self.inner.working_r() / self.problem.r_absolute
         for c, g in zip(self._chosen(), self._nodal_gaps(), strict=True):
             lam = c.lam.x.array[:g.size]
             smallest = comm.allreduce(float(np.min(g, initial=np.inf)), op=MPI.MIN)
             level = max(smallest, 0.0) if smallest <= self.touching_gap * c.surface.h else 0.0
             touch = (g <= level + 1e-12 * c.surface.h) & (lam >= 0.0)
-            r = float(c.r.value)
+            r = float(c.r.value) * at_work
             lam[touch] = -r * g[touch] - self.margin * 1e-6 * r * c.surface.h
             c.lam.x.scatter_forward()
