@@ -199,11 +199,57 @@ def test_self_contact_mistakes_are_named(tmp_path):
     with pytest.raises(SceneError, match=r"neighbourhood.*self_contact = true"):
         load_scene(path)
     path.write_text(text.replace("self_contact = true\nneighbourhood = 3.0\n", ""))
-    with pytest.raises(SceneError, match=r"a contact pair needs two bodies.*self_contact = true"):
+    with pytest.raises(SceneError, match=r"1 \[\[body\]\] block\(s\); \[\[pair\]\] 'inner' is "
+                       r"a contact pair between two bodies, and a contact pair needs two bodies: "
+                       r"add a \[\[body\]\] per body.*or self_contact = true in \[\[pair\]\] "
+                       r"'inner'"):
         load_scene(path)
     path.write_text(text.replace("neighbourhood = 3.0", "neighbourhood = -1.0"))
     with pytest.raises(SceneError, match="neighbourhood"):
         load_scene(path)
+    path.write_text(text.replace("[[pair]]\nname", "[pairing]\nautomatic = true\n\n[[pair]]\nname"))
+    with pytest.raises(SceneError, match=r"\[pairing\] automatic = true pairs every body with "
+                       r"every other, and a contact pair needs two bodies.*or remove \[pairing\]"):
+        load_scene(path)
+    bare = re.sub(r"^\[\[pair\]\]\n.*?\n\n", "", text, flags=re.S | re.M)
+    path.write_text(re.sub(r"^\[\[obstacle\]\]\n.*?\n\n", "", bare, flags=re.S | re.M))
+    with pytest.raises(SceneError, match=r"no contact: add a \[\[pair\]\] with striker and "
+                       r"target facet tags, \[pairing\] automatic = true, or an \[\[obstacle\]\]"):
+        load_scene(path)
+
+
+def _coarse_tube_alone(tmp_path: Path, form: str) -> Path:
+    """The crushed tube on a coarse mesh, pressed a little, without its self-contact pair.
+
+    ``form`` "body": one [[body]] block; "material": a [material] table.
+    """
+    text = SCENE.read_text().replace('"../meshes/', f'"{SCENE.parent.parent / "meshes"}/')
+    text = re.sub(r"^\[\[pair\]\]\n.*?\n\n", "", text, flags=re.S | re.M)
+    text = (text.replace("n_t = 4, n_q = 54", "n_t = 2, n_q = 12")
+            .replace("steps = 50", "steps = 3").replace("-1.81", "-0.3"))
+    if form == "material":
+        text = text.replace('[[body]]\nname = "tube"\ntag = "tube"\n', "[material]\n")
+    path = tmp_path / f"tube_{form}.toml"
+    path.write_text(text)
+    return path
+
+
+def test_one_body_with_obstacles_only_runs_as_the_material_form(tmp_path):
+    """A [[body]] scene with no [[pair]] (obstacles only) was refused: 'a contact pair needs
+    two bodies'. It is the [material] scene with its body named: the same steps and forces."""
+    body = load_scene(_coarse_tube_alone(tmp_path, "body"))
+    plain = load_scene(_coarse_tube_alone(tmp_path, "material"))
+    assert body.pairs == () and [b.name for b in body.bodies] == ["tube"]
+    assert (body.obstacle, body.contact) == (plain.obstacle, plain.contact)
+    runs = [run_scene(s, tmp_path / s.path.stem, comm=MPI.COMM_SELF, pictures=False)
+            for s in (body, plain)]
+    assert all(r.path.converged for r in runs)
+    forces = [[s["contact_force"] for s in r.summary["steps"]] for r in runs]
+    assert len(forces[0]) == 3 and forces[0][-1] > 0
+    assert forces[0] == pytest.approx(forces[1], rel=1e-10)
+    assert [r.summary["iterations"] for r in runs] == [runs[1].summary["iterations"]] * 2
+    assert runs[0].summary["bodies"][0]["name"] == "tube"
+    assert [o["name"] for o in runs[0].summary["obstacles"]] == ["bottom", "top"]
 
 
 @pytest.mark.mpi

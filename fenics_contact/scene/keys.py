@@ -118,7 +118,8 @@ KEY_DOCS: dict[str, dict[str, KeyDoc]] = {
         "dirichlet": KeyDoc("array of tables", "[[dirichlet]] blocks.", default="none"),
         "traction": KeyDoc("array of tables", "[[traction]] blocks.", default="none"),
         "obstacle": KeyDoc("table or array of tables", "[obstacle] (one, with [contact]) or "
-                           "[[obstacle]] blocks (several).", default="required without [[pair]]"),
+                           "[[obstacle]] blocks (several).",
+                           default="required without [[pair]] or [pairing]"),
         "contact": KeyDoc("table", "[contact]: the single obstacle's contact.",
                           default="required with [obstacle]"),
         "solver": KeyDoc("table", "[solver]: strategy and stepping.", default="all defaults"),

@@ -59,7 +59,8 @@ Deformable bodies in one mesh replace [material] and [contact] by::
     [[pair]]     name, striker, target (facet tags), r, relative,
                  mu, tangential_r_max (Coulomb friction, as in [contact]),
                  self_contact = true (the target on the striker's own body; target
-                 defaults to striker; one [[body]] is then enough), neighbourhood
+                 defaults to striker; one [[body]] is then enough; so it is with
+                 [[obstacle]] blocks and no pair), neighbourhood
                  (facet sizes along the surface a node does not search; default 3)
                  discretisation = "node-to-segment" (default) | "mortar"
                  (exact on non-matching meshes; 2D and 3D, with or without mu)
@@ -232,19 +233,30 @@ def _two_body_scene(path: Path, data: dict[str, Any], head: _Reader, dimension: 
     pairs = read_pairs(path, data, dimension)
     obstacles = read_obstacle_blocks(path, data, dimension)
     pairing = read_pairing(path, data)
-    if len(bodies) < 2 and not any(p.self_contact for p in pairs):
-        raise SceneError(f"{path.name}: {len(bodies)} [[body]] block(s); a contact pair needs "
-                         "two bodies: add a [[body]] per body (name, tag, law, E, nu), or "
-                         "self_contact = true in [[pair]] for a surface touching its own body.")
-    if not pairs and pairing is None:
-        raise SceneError(f"{path.name}: no [[pair]] block; add one with striker and target "
-                         "facet tags, or [pairing] automatic = true.")
+    between = [p.name for p in pairs if not p.self_contact]
+    if len(bodies) < 2 and (between or pairing is not None):
+        what, drop = ((f"[[pair]] {between[0]!r} is a contact pair between two bodies",
+                       f"self_contact = true in [[pair]] {between[0]!r} for a surface touching "
+                       "its own body") if between else
+                      ("[pairing] automatic = true pairs every body with every other",
+                       "remove [pairing] (one body against obstacles needs no pair)"))
+        raise SceneError(f"{path.name}: {len(bodies)} [[body]] block(s); {what}, and a "
+                         "contact pair needs two bodies: add a [[body]] per body (name, tag, "
+                         f"law, E, nu), or {drop}.")
+    if not pairs and pairing is None and not obstacles:
+        raise SceneError(f"{path.name}: no contact: add a [[pair]] with striker and target "
+                         "facet tags, [pairing] automatic = true, or an [[obstacle]] block.")
     names = [p.name for p in pairs] + [o.name for o in obstacles]
     if len(set(names)) != len(names):
         raise SceneError(f"{path.name}: contact names {names} repeat; give each [[pair]] and "
                          "[[obstacle]] its own name.")
-    pair = pairs[0] if pairs else PairSpec("automatic", "", "", r=pairing.r,  # type: ignore[union-attr]
-                                           relative=pairing.relative, mu=pairing.mu)  # type: ignore[union-attr]
+    if pairs:
+        contact = _pair_contact(pairs[0])
+    elif pairing is not None:
+        contact = _pair_contact(PairSpec("automatic", "", "", r=pairing.r,
+                                         relative=pairing.relative, mu=pairing.mu))
+    else:  # obstacles only: the first obstacle's, as in a [material] scene
+        contact = obstacles[0].contact
     output = _table(path, data, "output", required=False)
     mu = next((m for m in [p.mu for p in pairs] + [o.contact.mu for o in obstacles]
                + [pairing.mu if pairing else None]
@@ -259,15 +271,20 @@ def _two_body_scene(path: Path, data: dict[str, Any], head: _Reader, dimension: 
         nu=bodies[0].nu,
         dirichlet=dirichlet,
         tractions=tractions,
-        obstacle=ObstacleSpec("none"),
-        contact=ContactSpec(tag=pair.striker, r=pair.r, relative=pair.relative, mu=pair.mu,
-                            tangential_r_max=pair.tangential_r_max),
+        obstacle=ObstacleSpec("none") if pairs or pairing else obstacles[0].obstacle,
+        contact=contact,
         **_run_settings(path, data, output, fields),
         bodies=bodies,
         pairs=pairs,
         obstacles=obstacles,
         pairing=pairing,
     )
+
+
+def _pair_contact(pair: PairSpec) -> ContactSpec:
+    """The scene's first contact's fields from a pair (its striker as the tag)."""
+    return ContactSpec(tag=pair.striker, r=pair.r, relative=pair.relative, mu=pair.mu,
+                       tangential_r_max=pair.tangential_r_max)
 
 
 def _fields(output: _Reader, mu: float | None, section: str) -> tuple[str, ...]:

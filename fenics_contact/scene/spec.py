@@ -211,8 +211,12 @@ class Scene:
 
     @property
     def two_body(self) -> bool:
-        """True when the scene declares deformable bodies and contact pairs."""
-        return bool(self.pairs) or self.pairing is not None
+        """True when the scene declares [[body]] blocks, contact pairs or [pairing].
+
+        Such a scene is built body by body (each body's cells by its tag),
+        also with one [[body]] and obstacles only.
+        """
+        return bool(self.bodies) or bool(self.pairs) or self.pairing is not None
 
     @property
     def frictional(self) -> bool:
