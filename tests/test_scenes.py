@@ -157,6 +157,37 @@ def test_a_geo_variable_of_another_parameter_name_is_pointed_to_that_name(tmp_pa
         build_mesh(load_scene(scene_file))
 
 
+@pytest.mark.parametrize(("parameters", "expected"), [
+    ('R_out = 1.0, t = 0.25, n_t = 2', [
+        "tube_crush.geo declares no parameter 'R_out', 't'; ",
+        "'R_out' is the .geo variable of the parameter 'outer radius': set "
+        '"outer radius" = 1.0; ',
+        "'t' is the .geo variable of the parameter 'wall thickness': set "
+        '"wall thickness" = 0.25 ',
+        '(it declares: n_q, n_t, "outer radius", "wall thickness"; a name with a space is a '
+        'quoted key in TOML, as written here: parameters = { "outer radius" = ... }).']),
+    ("thickness = 0.25", [
+        "tube_crush.geo declares no parameter 'thickness'; it declares: n_q, n_t, "
+        '"outer radius", "wall thickness"; a name with a space is a quoted key in TOML']),
+])
+def test_a_geo_variable_of_a_parameter_named_with_a_space_is_pointed_to_it(
+        tmp_path, parameters, expected):
+    """t = {0.1, Name "Parameters/wall thickness"}: the variable named, the key quoted."""
+    from mpi4py import MPI
+
+    from fenics_contact.scene.build import build_mesh
+
+    shipped = SCENES / "tube_crush.toml"
+    text = shipped.read_text().replace('"../meshes/', f'"{shipped.parents[1]}/meshes/')
+    scene_file = tmp_path / "tube.toml"
+    scene_file.write_text(text.replace("n_t = 4, n_q = 54", parameters))
+    with pytest.raises(SceneError) as raised:
+        build_mesh(load_scene(scene_file), MPI.COMM_SELF)
+    assert "\n" not in str(raised.value)
+    for phrase in expected:
+        assert phrase in str(raised.value), str(raised.value)
+
+
 def test_geo_parameter_in_the_plain_form_is_named_with_the_form_to_use(tmp_path, capsys):
     """DefineConstant[h = 0.1] cannot be set from a scene: the message says how to declare it."""
     from fenics_contact.cli import main

@@ -8,6 +8,7 @@ themselves are the ``meshes/*.geo`` files, the only description of each.
 
 from __future__ import annotations
 
+import json
 import re
 import signal
 from collections.abc import Callable, Iterator
@@ -151,6 +152,20 @@ def overlapping_groups(gmsh: Any) -> str:
     return ""
 
 
+def _toml_key(name: str) -> str:
+    """``name`` as a key of a TOML table: bare when it may be, else quoted."""
+    return name if re.fullmatch(r"[A-Za-z0-9_-]+", name) else json.dumps(name)
+
+
+def _declared(names: set[str]) -> str:
+    """A .geo file's parameter names as TOML keys, and how a quoted one is written."""
+    keys = [_toml_key(n) for n in sorted(names)]
+    quoted = any(k != n for k, n in zip(keys, sorted(names), strict=True))
+    return ", ".join(keys) + ("; a name with a space is a quoted key in TOML, as written "
+                              "here: parameters = { " + next(k for k in keys if k[0] == '"')
+                              + " = ... }" if quoted else "")
+
+
 def open_geo(gmsh: Any, path: Path | str, parameters: dict[str, float]) -> None:
     """Open a gmsh .geo or .msh file in the current session with ``parameters`` set.
 
@@ -169,14 +184,17 @@ def open_geo(gmsh: Any, path: Path | str, parameters: dict[str, float]) -> None:
         if unknown:
             first = unknown[0]
             # a variable whose parameter has another name: R = {1, Name "Parameters/radius"}
-            named = dict(re.findall(r"(\w+)\s*=\s*\{[^}]*Name\s*\"Parameters/(\w+)\"",
+            # or t = {0.1, Name "Parameters/wall thickness"}
+            named = dict(re.findall(r"(\w+)\s*=\s*\{[^}]*Name\s*\"Parameters/([^\"]+)\"",
                                     Path(path).read_text(errors="replace")))
+            moved = [k for k in unknown if k in named and named[k] != k]
             renamed = [f"{k!r} is the .geo variable of the parameter {named[k]!r}: set "
-                       f"{named[k]} = ..." for k in unknown if k in named and named[k] != k]
+                       f"{_toml_key(named[k])} = {parameters[k]!r}" for k in moved]
             if renamed:
-                raise ValueError(f"{Path(path).name} declares no parameter "
-                                 f"{', '.join(map(repr, unknown))}; " + "; ".join(renamed)
-                                 + f" (it declares: {', '.join(sorted(declared))}).")
+                raise ValueError(
+                    f"{Path(path).name} declares no parameter {', '.join(map(repr, unknown))}; "
+                    + "; ".join(renamed) + f" (it declares: {_declared(declared)})."
+                )
             # declared under another ONELAB path: x = {1, Name "P/x"}
             elsewhere = {k: v for k, v in re.findall(
                 r"(\w+)\s*=\s*\{[^}]*Name\s*\"([^\"]+)\"", Path(path).read_text(
@@ -190,7 +208,7 @@ def open_geo(gmsh: Any, path: Path | str, parameters: dict[str, float]) -> None:
                                  + ".")
             raise ValueError(
                 f"{Path(path).name} declares no parameter {', '.join(map(repr, unknown))}; "
-                f"it declares: {', '.join(sorted(declared)) or 'none'}. A parameter the scene "
+                f"it declares: {_declared(declared) or 'none'}. A parameter the scene "
                 f"may set is declared in the .geo as DefineConstant[{first} = {{value, Name "
                 f'"Parameters/{first}"}}]; (the plain form DefineConstant[{first} = value] '
                 "cannot be set from outside the file)."
