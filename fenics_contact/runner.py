@@ -107,7 +107,7 @@ def _summary(scene: Scene, record: RunRecord, used: dict[str, dict] | None = Non
         "forcing": scene.solver.forcing,
         "reuse_preconditioner": scene.solver.reuse_preconditioner,
         "load_steps": scene.solver.steps,
-        **record.to_dict(),
+        **_marked(record.to_dict()),
         "pairs": [
             {
                 "name": pair.name, "striker": pair.striker, "target": pair.target,
@@ -171,6 +171,34 @@ def _placed(spec, t: float) -> list[float]:
     motion = np.zeros(len(spec.point)) if not spec.motion else np.asarray(spec.motion, float)
     schedule = obstacle_schedule(spec.schedule or None, len(spec.point))
     return (np.asarray(spec.point, float) + obstacle_offset(motion, schedule, t)).tolist()
+
+
+def _marked(run: dict) -> dict:
+    """The run's dict with each step marked ``written`` (in solution.xdmf) or not.
+
+    A failed step's record holds the state the run stopped in, which no file
+    holds when the step got part of the way; its ``note`` says so and names
+    the last step written.
+    """
+    done = None
+    for s in run["steps"]:
+        s["written"] = s["status"] == "converged"
+        if s["written"]:
+            done = s
+            continue
+        on_disk = (f"solution.xdmf ends at step {done['step']} (load factor "
+                   f"{done['load_factor']:g})" if done else "solution.xdmf holds no step")
+        if done is not None and s["load_factor"] == done["load_factor"]:
+            where = f"step {done['step']}'s, the last written"
+        elif done is None and s["load_factor"] == 0.0:
+            where = "the start"
+        else:
+            where = "the last converged part of this step, not written"
+        at = "" if s.get("failed_at") is None else f" at load factor {s['failed_at']:g}"
+        s["note"] = (f"the failed step ({s['status']}{at}): "
+                     f"load_factor and the forces here are the state the run stopped in, "
+                     f"at load factor {s['load_factor']:g} ({where}); {on_disk}")
+    return run
 
 
 def _contact_steps(record: RunRecord, name: str, frictional: bool) -> list[dict]:
@@ -384,8 +412,37 @@ def run_scene(
             (out / SCRIPT).unlink(missing_ok=True)
         return RunOutcome(problem, path, summary, out)
     if scene.pictures if pictures is None else pictures:
-        draw_pictures(scene, problem, path, out)
+        if path.steps and path.steps[-1].status != "converged":
+            # the pictures show the last step on disk, not the failed step's partial state
+            with _at_last_written_step(problem, out / "checkpoint", run_identity):
+                draw_pictures(scene, problem, path, out, shown=_last_written(path))
+        else:
+            draw_pictures(scene, problem, path, out)
     return RunOutcome(problem, path, summary, out)
+
+
+def _last_written(path: RunRecord) -> StepRecord | None:
+    """The record of the last converged load step: the last one in solution.xdmf."""
+    return next((s for s in reversed(path.steps) if s.status == "converged"), None)
+
+
+@contextmanager
+def _at_last_written_step(problem: ContactProblem, folder: Path, run_identity: dict):
+    """Put ``problem`` at its last checkpoint (the last step written) inside; back after.
+
+    A failed step stops at the last converged part of its increment, which
+    no file holds. Its checkpoint gives the written step exactly (u, the
+    multipliers, the load factor and the friction history); afterwards the
+    problem is back in the state the run stopped in, whose u is its own
+    committed state (the failed attempt started from it).
+    """
+    stopped = problem.snapshot()
+    restore(folder, problem, read_latest(folder, run_identity))
+    try:
+        yield
+    finally:
+        problem.restore(stopped)
+        problem.commit()
 
 
 def scene_strategy(scene: Scene, problem: ContactProblem,
@@ -402,16 +459,20 @@ def scene_strategy(scene: Scene, problem: ContactProblem,
     )
 
 
-def draw_pictures(scene: Scene, problem: ContactProblem, path: RunRecord, out: Path) -> None:
-    """OUT/deformed.png, residuals.png and, with friction, friction.png of the last step."""
+def draw_pictures(scene: Scene, problem: ContactProblem, path: RunRecord, out: Path,
+                  shown: StepRecord | None = None) -> None:
+    """OUT/deformed.png, residuals.png and, with friction, friction.png of the problem's state.
+
+    ``shown``: the record of the load step whose state the problem holds (a
+    failed run's last written step); None: the state the path ended in (its
+    last record). The titles name that step, its load factor and contact
+    force, and a failed step beside it.
+    """
     from fenics_contact.output.pictures import deformed_contact_picture
     from fenics_contact.output.plotting import step_residuals
 
-    last = path.steps[-1].load_factor if path.steps else problem.load_factor
-    deformed_contact_picture(
-        problem, out / "deformed.png",
-        title=f"{scene.name}: load factor {last:g} ({path.status})",
-    )
+    title = picture_title(scene.name, path, shown)
+    deformed_contact_picture(problem, out / "deformed.png", title=title)
     if problem.comm.rank == 0 and path.steps:
         step_residuals(path.steps, out / "residuals.png", title=scene.name)
     if scene.frictional:
@@ -419,9 +480,40 @@ def draw_pictures(scene: Scene, problem: ContactProblem, path: RunRecord, out: P
 
         friction_profile(
             problem, out / "friction.png",  # type: ignore[arg-type]
-            title=f"{scene.name}: tangential traction, load factor {last:g}",
+            title=picture_title(f"{scene.name}, tangential traction", path, shown,
+                                force=False),
         )
 
 
+def picture_title(name: str, path: RunRecord, shown: StepRecord | None = None, *,
+                  force: bool = True) -> str:
+    """The title of a run's pictures: the step shown, its load factor and contact force.
+
+    A failed run's pictures show its last written step (``shown``) and name
+    the failed step on a second line; without one (no step written) they
+    show the state the failed step stopped in and say so. ``force`` False
+    leaves the contact force out (a narrow plot).
+    """
+    if not path.steps:
+        return f"{name}: load factor 0 ({path.status})"
+    last = path.steps[-1]
+    shown = shown or last
+
+    def state(s: StepRecord) -> str:
+        return (f"step {s.step}, load factor {s.load_factor:g}"
+                + (f", contact force {s.contact_force:.4g}" if force else ""))
+
+    if last.status == "converged":
+        return f"{name}: {state(last)} ({path.status})"
+    failed = (f"step {last.step} {last.status} at load factor "
+              f"{last.failed_at if last.failed_at is not None else last.load_factor:g}")
+    if shown is last:
+        return (f"{name}: {failed}; shown: the state it stopped in, load factor "
+                f"{last.load_factor:g}"
+                + (f", contact force {last.contact_force:.4g}" if force else "")
+                + " (not written)")
+    return f"{name}: {state(shown)}, the last step written\n({failed})"
+
+
 __all__ = ["RUN_FILES", "RunOutcome", "SolveResult", "contact_settings", "draw_pictures",
-           "earlier_run", "run_scene", "scene_strategy"]
+           "earlier_run", "picture_title", "run_scene", "scene_strategy"]

@@ -356,3 +356,80 @@ def test_a_support_that_drives_a_node_into_an_obstacle_is_named(tmp_path, capsys
     # the state it stopped in, and the load factor of its last attempt
     assert (last["load_factor"], last["failed_at"]) == (0.5, 0.625)
     assert "at load factor 0.625" in last["message"]
+
+
+#: A block whose top is dragged 0.1 towards a wall 0.05 away while a ball presses it:
+#: step 2 (of 3) converges half-way (load factor 0.5, the dragged corner at the wall) and
+#: fails past it, so the state it stops in lies between step 1 and the failed attempt.
+DRAGGED_AND_PRESSED = (
+    '[scene]\nname = "dragged"\ndimension = 2\n\n'
+    '[mesh]\ngenerator = "rectangle"\norigin = [0.0, 0.0]\nsize = [1.0, 0.5]\n'
+    'cells = [10, 5]\n\n[material]\nlaw = "linear"\nE = 200.0\nnu = 0.3\n\n'
+    '[[obstacle]]\nname = "press"\ntype = "ball"\ncentre = [0.5, 1.0]\nradius = 0.5\n'
+    'motion = [0.0, -0.06]\ntag = "top"\n\n'
+    '[[obstacle]]\nname = "wall"\ntype = "plane"\npoint = [1.05, 0.0]\n'
+    'normal = [-1.0, 0.0]\ntag = "right"\n\n'
+    '[[dirichlet]]\ntag = "bottom"\nvalue = [0.0, 0.0]\n\n'
+    '[[dirichlet]]\ntag = "top"\nvalue = [0.1, "free"]\n\n'
+    '[solver]\nmethod = "gnrm"\nsteps = 3\nmax_cutbacks = 2\n')
+
+
+def test_a_failed_runs_pictures_show_the_last_step_written(tmp_path, monkeypatch):
+    """Before, deformed.png showed and was titled with the state the failed step stopped
+    in (load factor 0.5, force 4.73), which solution.xdmf does not hold (it ends at step 1,
+    0.333, force 2.97), and summary.json's last record did not say it was not written."""
+    import fenics_contact.output.pictures as pictures
+
+    path = tmp_path / "dragged.toml"
+    path.write_text(DRAGGED_AND_PRESSED)
+    drawn = []
+
+    def picture(problem, png, title=""):
+        drawn.append((title, problem.load_factor, problem.u.x.array.copy(),
+                      sum(s.contact_force for s in problem.contact_states().values())))
+
+    monkeypatch.setattr(pictures, "deformed_contact_picture", picture)
+    outcome = run_scene(load_scene(path), tmp_path / "out", comm=MPI.COMM_SELF, pictures=True)
+    first, failed = outcome.path.steps
+    assert (first.status, failed.status) == ("converged", "cycling")
+    assert (failed.load_factor, failed.failed_at) == (0.5, pytest.approx(0.5833333333333334))
+    assert first.contact_force == pytest.approx(2.968, rel=1e-3)
+    assert failed.contact_force == pytest.approx(4.730, rel=1e-3)
+    # the picture: step 1's state, titled so, and the failed step named beside it
+    (title, t, u, force), = drawn
+    assert title == ("dragged: step 1, load factor 0.333333, contact force 2.968, the last "
+                     "step written\n(step 2 cycling at load factor 0.583333)")
+    assert t == pytest.approx(1 / 3, abs=1e-15)
+    (_, grid), = read_xdmf(tmp_path / "out" / "solution.xdmf")  # step 1 only (float32)
+    on_disk = np.linalg.norm(grid.point_data["displacement"], axis=1)
+    assert np.linalg.norm(u.reshape(-1, 2), axis=1).max() == pytest.approx(on_disk.max(),
+                                                                           rel=1e-6)
+    assert force == pytest.approx(first.contact_force, rel=1e-10)
+    # the problem is back in the state the run stopped in, as its record says
+    assert outcome.problem.load_factor == 0.5
+    assert sum(s.contact_force for s in outcome.problem.contact_states().values()) == \
+        pytest.approx(failed.contact_force, rel=1e-10)
+    steps = json.loads((tmp_path / "out" / "summary.json").read_text())["steps"]
+    assert [s["written"] for s in steps] == [True, False]
+    assert "note" not in steps[0]
+    assert steps[1]["note"] == (
+        "the failed step (cycling at load factor 0.583333): load_factor and the forces here "
+        "are the state the run stopped in, at load factor 0.5 (the last converged part of "
+        "this step, not written); solution.xdmf ends at step 1 (load factor 0.333333)")
+
+
+
+def test_picture_titles_name_the_step_shown_and_a_failed_one():
+    """Converged: the last step; failed with no step written (the first step's forms
+    compiled ahead of a run): the state it stopped in, said to be no written step."""
+    from fenics_contact.runner import picture_title
+    from fenics_contact.solvers.stepping import RunRecord, StepRecord
+
+    done = StepRecord(step=2, load_factor=1.0, status="converged", contact_force=3.25)
+    assert picture_title("s", RunRecord("converged", [done])) == (
+        "s: step 2, load factor 1, contact force 3.25 (converged)")
+    stuck = StepRecord(step=1, load_factor=0.25, status="diverged", failed_at=0.375,
+                       contact_force=1.5)
+    assert picture_title("s", RunRecord("diverged", [stuck])) == (
+        "s: step 1 diverged at load factor 0.375; shown: the state it stopped in, load "
+        "factor 0.25, contact force 1.5 (not written)")

@@ -37,8 +37,10 @@ class StepRecord:
 
     A failed step's record holds the state the run stopped in: the last
     converged one, at ``load_factor`` (its forces, counts, det F and
-    reactions); ``message`` names the load factor it failed at (det F is the
-    failed attempt's when it turned elements inside out).
+    reactions), part of the way through the step when a halved increment
+    converged before the last attempt failed; ``message`` names the load
+    factor it failed at (det F is the failed attempt's when it turned
+    elements inside out).
 
     Attributes:
         step: 1-based step number.
