@@ -288,7 +288,9 @@ class SelfContactPair(DeformablePair):
             inside = penetration_depth(points, current, size=self._size, nearest=nearest,
                                        free=self.target.free) > depth
             rows = np.flatnonzero(inside)
-            found = bool(np.asarray(self.excluded[rows, nearest.facet[rows]]).any())
+            # (no row: scipy returns an empty sparse matrix, which numpy cannot read)
+            found = bool(rows.size) and bool(
+                np.asarray(self.excluded[rows, nearest.facet[rows]]).any())
         return bool(self.comm.allreduce(found, op=MPI.LOR))
 
     def _node_normals(self) -> np.ndarray:
