@@ -35,6 +35,7 @@ from fenics_contact.scene.slot_overflow import warn_slot_overflow, warn_slots_ca
 from fenics_contact.scene.striker_advice import advise_striker
 from fenics_contact.scene.unpaired_overlap import warn_unpaired_overlap
 from fenics_contact.solvers import make_strategy
+from fenics_contact.solvers.auto import AutoStrategy
 from fenics_contact.solvers.base import SolveResult
 from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.predictor import ActiveSetPredicted, Extrapolated
@@ -348,6 +349,9 @@ def run_scene(
         strategy.history = saved.history
         if isinstance(strategy, ActiveSetPredicted):
             strategy.gap_history = saved.gaps
+    solver = strategy.inner if isinstance(strategy, Extrapolated) else strategy
+    if isinstance(solver, AutoStrategy) and saved is not None:
+        solver.r_cap = saved.r_cap
     record = start_record(strategy)
     record.steps = [StepRecord(**r) for r in saved.records] if saved is not None else []
     record.wall_s = sum(s.wall_s for s in record.steps)  # a resumed run counts its earlier part
@@ -370,7 +374,8 @@ def run_scene(
         history = strategy.history if isinstance(strategy, Extrapolated) else []
         gaps = strategy.gap_history if isinstance(strategy, ActiveSetPredicted) else []
         checkpoint.write(step.step, [s.to_dict() for s in record.steps], history,
-                         files=writer.written, gaps=gaps)
+                         files=writer.written, gaps=gaps,
+                         r_cap=solver.r_cap if isinstance(solver, AutoStrategy) else None)
         _write_summary(comm, out, scene, record, used, notes)
         if on_step is not None:
             on_step(step)

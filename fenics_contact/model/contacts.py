@@ -225,6 +225,17 @@ class Contact:
     def commit_frame(self) -> None:
         """Move the reference of the slip forward after a converged increment."""
 
+    def search_state(self) -> dict[str, np.ndarray]:
+        """What the next search carries over from the last ones (local arrays; a checkpoint).
+
+        Empty for a contact whose search keeps nothing from one search to the
+        next (an obstacle; a mortar pair searches afresh each time).
+        """
+        return {}
+
+    def restore_search_state(self, state: dict[str, np.ndarray]) -> None:
+        """Put back a :meth:`search_state` (a resumed run; collective)."""
+
     def extras(self) -> list[fem.Function]:
         """Coefficients that are a selection of u (a deformable target's displacements)."""
         return []

@@ -301,6 +301,80 @@ class DeformablePair:
             self.version += 1
         return changed
 
+    # -- the search's memory (a resumed run) -------------------------------------------
+    def search_state(self) -> dict[str, np.ndarray]:
+        """What the next search carries over from the last ones (local arrays, this rank).
+
+        The facet each node holds (the hysteresis keeps it while it stays
+        about as close as the closest one), the lifts (a self-contact node
+        lifted at the last search has no facet to keep), the last projection
+        and the skin of the search (which nodes the next one skips), the kept
+        target facets, the coefficients filled from them, and whether the
+        current u is the one last searched (the next refresh is then skipped).
+        A fresh pair restored with :meth:`restore_search_state` searches on as
+        this one does: without it the first search after a resume starts
+        from no facet and may pick the other of two facets that tie (a node
+        at their common vertex).
+        """
+        proj = self.projection
+        n = self.assignment.size
+        skin = self._skin_points is not None
+        state = {f"kept_{k}": v for k, v in self.target.kept_state().items()}
+        state |= {
+            "assignment": self.assignment.copy(),
+            "lift": self.lift.x.array.copy(),
+            "projection": np.array(proj is not None),
+            "xi": proj.xi.copy() if proj is not None else np.zeros((n, self.gdim - 1)),
+            "distance": proj.distance.copy() if proj is not None else np.zeros(n),
+            "overshoot": proj.overshoot.copy() if proj is not None else np.zeros(n),
+            "slack": self._slack.copy(),
+            "skin": np.array(skin),
+            "skin_points": self._skin_points.copy() if skin else np.zeros((0, self.gdim)),
+            "skin_current": (self._skin_current.copy() if skin
+                             else np.zeros((0, self.gdim, self.gdim))),
+            "coupled": self._coupled.copy(),
+            "size": np.array(self._size),
+            "searched_here": np.array(self._searched_u is not None
+                                      and np.array_equal(self._searched_u, self.u.x.array)),
+        }
+        for k in range(self.gdim):
+            state[f"X{k}"] = self.X[k].x.array.copy()
+            state[f"w{k}"] = self.w[k].x.array.copy()
+        return state
+
+    def restore_search_state(self, state: dict[str, np.ndarray]) -> None:
+        """Put back a :meth:`search_state` at the u it was taken at (collective).
+
+        Raises:
+            ValueError: the state was taken on another surface (its arrays do
+                not fit this pair's nodes).
+        """
+        n = self.assignment.size
+        if (state["assignment"].shape != (n,) or state["lift"].shape != self.lift.x.array.shape
+                or state["coupled"].shape != self._coupled.shape):
+            raise ValueError("The saved search state does not fit this pair's striker nodes.")
+        self.target.restore_kept({k[len("kept_"):]: v for k, v in state.items()
+                                  if k.startswith("kept_")}, self.u)
+        self.assignment = np.asarray(state["assignment"], np.int64).copy()
+        self.lift.x.array[:] = state["lift"]
+        self.projection = (Projection(self.assignment.copy(), np.array(state["xi"]),
+                                      np.array(state["distance"]), np.array(state["overshoot"]))
+                           if bool(state["projection"]) else None)
+        self._slack = np.array(state["slack"])
+        skin = bool(state["skin"])
+        self._skin_points = np.array(state["skin_points"]) if skin else None
+        self._skin_current = np.array(state["skin_current"]) if skin else None
+        self._coupled = np.array(state["coupled"], bool)
+        self._size = float(state["size"])
+        self._searched_u = self.u.x.array.copy() if bool(state["searched_here"]) else None
+        for k in range(self.gdim):
+            self.X[k].x.array[:] = state[f"X{k}"]
+            self.w[k].x.array[:] = state[f"w{k}"]
+        if self.w_prev is not None:
+            self._prev_t = self.target_displacements(self._u_prev)
+            self._fill_previous()
+        self.version += 1
+
     def _lift_past_rim(self, points: np.ndarray, current: np.ndarray, proj: Projection) -> None:
         """Lift the gap of the nodes past the target's rim to their distance from it.
 
@@ -587,6 +661,14 @@ class NodeToSegmentContact(Contact):
     def refresh(self) -> bool:
         """Search and refill the target coefficients when u has changed."""
         return self.pair.refresh()
+
+    def search_state(self) -> dict[str, np.ndarray]:
+        """The pair's search memory (:meth:`DeformablePair.search_state`)."""
+        return self.pair.search_state()
+
+    def restore_search_state(self, state: dict[str, np.ndarray]) -> None:
+        """Put back a :meth:`search_state` (a resumed run; collective)."""
+        self.pair.restore_search_state(state)
 
     def extras(self) -> list[fem.Function]:
         """The target vertex displacements w_k (condensed by w_k = S_k u)."""

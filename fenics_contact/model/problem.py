@@ -294,6 +294,22 @@ class ContactProblem(FrictionalContacts):
         self.committed_load_factor = float(committed_load_factor)
         self.set_load(t)
 
+    def search_states(self) -> list[dict[str, np.ndarray]]:
+        """Each contact's search memory, in the order of the contacts (local arrays; a checkpoint).
+
+        See :meth:`Contact.search_state <.contacts.Contact.search_state>`.
+        """
+        return [c.search_state() for c in self.contacts]
+
+    def restore_search_states(self, states: list[dict[str, np.ndarray]]) -> None:
+        """Put back :meth:`search_states` at the u they were taken at (a resumed run)."""
+        if len(states) != len(self.contacts):
+            raise ValueError(f"{len(states)} saved search states for {len(self.contacts)} "
+                             "contacts.")
+        for c, state in zip(self.contacts, states, strict=True):
+            if state:
+                c.restore_search_state(state)
+
     def snapshot(self) -> ProblemState:
         """Copy u, every multiplier and the load factor (see :meth:`restore`)."""
         return ProblemState(

@@ -199,16 +199,10 @@ class TargetSurface:
             send.append((self._own_gid[hit], self._own_blocks[hit], self._own_X[hit],
                          self._own_free[hit]))
         got = self.comm.alltoall(send)
-        gid = np.concatenate([self.gid, *(g[0] for g in got)])
-        blocks = np.concatenate([self.blocks, *(g[1] for g in got)])
-        X = np.concatenate([self._X, *(g[2] for g in got)])
-        free = np.concatenate([self.free, *(g[3] for g in got)])
-        gid, first = np.unique(gid, return_index=True)  # kept facets stay kept
-        self.gid, self.blocks, self._X, self.free = gid, blocks[first], X[first], free[first]
-        self.vertices, inverse = np.unique(self.blocks, return_inverse=True)
-        self.facet_vertex = inverse.reshape(-1, self.nv)
-        self.X_vertices = np.zeros((self.vertices.size, gd))
-        self.X_vertices[self.facet_vertex.reshape(-1)] = self._X.reshape(-1, gd)
+        self._keep(np.concatenate([self.gid, *(g[0] for g in got)]),
+                   np.concatenate([self.blocks, *(g[1] for g in got)]),
+                   np.concatenate([self._X, *(g[2] for g in got)]),
+                   np.concatenate([self.free, *(g[3] for g in got)]))
         tlo = lo.min(axis=0) if lo.size else np.full(gd, np.inf)
         thi = hi.max(axis=0) if hi.size else np.full(gd, -np.inf)
         box_lo, box_hi = np.empty(gd), np.empty(gd)
@@ -216,6 +210,57 @@ class TargetSurface:
         self.comm.Allreduce(np.ascontiguousarray(thi, float), box_hi, op=MPI.MAX)
         self._target_box = np.array([box_lo, box_hi])
         self._u0 = u.x.array.reshape(-1, gd)[self._own_vertex].copy()
+        self._make_scatter(u)
+        self.gathers += 1
+
+    def _keep(self, gid: np.ndarray, blocks: np.ndarray, X: np.ndarray,
+              free: np.ndarray) -> None:
+        """Keep these facets (repeats dropped), numbered by global index."""
+        gid, first = np.unique(gid, return_index=True)  # kept facets stay kept
+        self.gid, self.blocks, self._X, self.free = gid, blocks[first], X[first], free[first]
+        self.vertices, inverse = np.unique(self.blocks, return_inverse=True)
+        self.facet_vertex = inverse.reshape(-1, self.nv)
+        self.X_vertices = np.zeros((self.vertices.size, self.gdim))
+        self.X_vertices[self.facet_vertex.reshape(-1)] = self._X.reshape(-1, self.gdim)
+
+    # -- a resumed run ---------------------------------------------------------------------
+    def kept_state(self) -> dict[str, np.ndarray]:
+        """What the exchanges so far left: the kept facets, the box, the last exchange's state.
+
+        Local arrays of this rank; :meth:`restore_kept` puts them back.
+        """
+        box = np.full((2, self.gdim), np.nan) if self.box is None else self.box
+        return {"gid": self.gid.copy(), "box": np.array(box, float),
+                "target_box": self._target_box.copy(), "u0": self._u0.copy()}
+
+    def restore_kept(self, state: dict[str, np.ndarray], u: fem.Function) -> None:
+        """Keep exactly the facets of a :meth:`kept_state` (collective; a resumed run).
+
+        Each facet is asked of the rank that owns it, so the kept set, its
+        numbering and the motion since the last exchange are those of the run
+        that wrote the state (a fresh exchange keeps what the box reaches at
+        the current u, which may be other facets).
+        """
+        gid = np.asarray(state["gid"], np.int64)
+        counts = np.asarray(self.comm.allgather(self._own_gid.size), np.int64)
+        ends = np.cumsum(counts)
+        owner = np.searchsorted(ends, gid, side="right")
+        asked = self.comm.alltoall([gid[owner == r] for r in range(self.comm.size)])
+        start = ends[self.comm.rank] - counts[self.comm.rank]
+        send = []
+        for wanted in asked:
+            k = np.asarray(wanted, np.int64) - start
+            send.append((self._own_gid[k], self._own_blocks[k], self._own_X[k],
+                         self._own_free[k]))
+        got = self.comm.alltoall(send)
+        self._keep(np.concatenate([np.zeros(0, np.int64), *(g[0] for g in got)]),
+                   np.concatenate([np.zeros((0, self.nv), np.int64), *(g[1] for g in got)]),
+                   np.concatenate([np.zeros((0, self.nv, self.gdim)), *(g[2] for g in got)]),
+                   np.concatenate([np.zeros((0, self.nv), bool), *(g[3] for g in got)]))
+        box = np.asarray(state["box"], float)
+        self.box = None if np.isnan(box).any() else box.copy()
+        self._target_box = np.asarray(state["target_box"], float).copy()
+        self._u0 = np.asarray(state["u0"], float).reshape(self._u0.shape).copy()
         self._make_scatter(u)
         self.gathers += 1
 

@@ -4,7 +4,8 @@ Layout (in the run's output folder)::
 
     checkpoint/latest.json              which step, the run's identity, the step records
     checkpoint/step_0007/rank_0000.npz  each process's owned displacement and
-    checkpoint/step_0007/rank_0001.npz  multiplier values (and predictor history)
+    checkpoint/step_0007/rank_0001.npz  multiplier values (and predictor history,
+                                        and each contact's search memory)
 
 Every process writes its own NumPy file of the degrees of freedom it owns
 (no parallel I/O library needed, so it works with the DOLFINx wheel and
@@ -81,6 +82,8 @@ class Checkpoint:
             displacement, full local multiplier arrays, ghosts included), oldest first.
         gaps: the nodal gaps of those states, when the predictor keeps them
             (owned values joined over the contacts; empty otherwise).
+        r_cap: the top of the working r that ``auto`` lowered after a failure
+            (relative to E/h; None when it did not, or another method).
     """
 
     step: int
@@ -88,6 +91,7 @@ class Checkpoint:
     records: list[dict]
     history: list[tuple[float, np.ndarray, np.ndarray]]
     gaps: list[np.ndarray] = field(default_factory=list)
+    r_cap: float | None = None
 
 
 def _file_digest(path: Path) -> str:
@@ -231,6 +235,32 @@ def _full_joined(problem: ContactProblem, owned: np.ndarray) -> np.ndarray:
     return np.concatenate(parts)
 
 
+#: The key of a contact's search array in a process's file: search_<contact>_<name>.
+_SEARCH_KEY = re.compile(r"search_(\d+)_(.+)")
+
+
+def _search_arrays(problem: ContactProblem) -> dict[str, np.ndarray]:
+    """Each contact's search memory (:meth:`ContactProblem.search_states`) as file entries."""
+    states = problem.search_states()
+    out = {"search_contacts": np.int64(len(states))}
+    for i, state in enumerate(states):
+        out |= {f"search_{i}_{key}": np.asarray(value) for key, value in state.items()}
+    return out
+
+
+def _search_states(problem: ContactProblem, data: dict[str, np.ndarray]
+                   ) -> list[dict[str, np.ndarray]] | None:
+    """The search states of a process's file; None when it has none (an older checkpoint)."""
+    if "search_contacts" not in data:
+        return None
+    states: list[dict[str, np.ndarray]] = [{} for _ in range(int(data["search_contacts"]))]
+    for key, value in data.items():
+        match = _SEARCH_KEY.fullmatch(key)
+        if match is not None and int(match[1]) < len(states):
+            states[int(match[1])][match[2]] = value
+    return states
+
+
 def _rank_file(folder: Path, step: int, rank: int) -> Path:
     return folder / f"step_{step:04d}" / f"rank_{rank:04d}.npz"
 
@@ -312,11 +342,14 @@ class CheckpointWriter:
         history: list[tuple[float, np.ndarray, np.ndarray]] = (),  # type: ignore[assignment]
         files: Sequence[Path] = (),
         gaps: Sequence[np.ndarray] = (),
+        r_cap: float | None = None,
     ) -> None:
         """Save the state after load step ``step`` (records: steps 1 .. step).
 
         ``history`` and ``gaps``: the predictor's converged states and their
-        nodal gaps (:class:`Checkpoint`).
+        nodal gaps; ``r_cap``: the working r's cap of ``auto``
+        (:class:`Checkpoint`). Each contact's search memory is saved too
+        (:meth:`ContactProblem.search_states`).
 
         ``files``: output files (closed) that a resume must find unchanged;
         their sizes and SHA-256 go into ``latest.json``.
@@ -341,6 +374,8 @@ class CheckpointWriter:
                 history_gap=np.array(list(gaps), dtype=np.float64).reshape(
                     len(gaps), gaps[0].size if len(gaps) else 0),
                 **self._coordinates,
+                **_search_arrays(p),
+                r_cap=np.float64(np.nan if r_cap is None else r_cap),
             )
         except OSError as exc:
             failure = write_failure(exc, path)
@@ -417,6 +452,19 @@ def restore(folder: Path, problem: ContactProblem, marker: dict) -> Checkpoint:
     for name, f in fields.items():
         f.x.array[:] = _full(f, data[name])
     problem.set_load(float(data["load_factor"]))
+    searches = _search_states(problem, data)
+    failure = None
+    if searches is not None:  # absent in older checkpoints: the searches start afresh
+        try:
+            problem.restore_search_states(searches)
+        except ValueError as exc:
+            failure = f"process {comm.rank}: {exc}"
+    failures = [m for m in comm.allgather(failure) if m is not None]
+    if failures:
+        raise CheckpointError(
+            f"Checkpoint {folder} (step {step}) does not fit this scene: {'; '.join(failures)}. "
+            "Run without --resume to start afresh."
+        )
     problem.restore_commit(float(data["committed_load_factor"]))
     history = [
         (float(t), _full(problem.u, hu), _full_joined(problem, hl))
@@ -424,8 +472,10 @@ def restore(folder: Path, problem: ContactProblem, marker: dict) -> Checkpoint:
                              strict=True)
     ]
     gaps = list(data.get("history_gap", np.zeros((0, 0))))  # absent in older checkpoints
+    r_cap = float(data.get("r_cap", np.nan))
     comm.Barrier()
-    return Checkpoint(step, float(data["load_factor"]), list(marker["records"]), history, gaps)
+    return Checkpoint(step, float(data["load_factor"]), list(marker["records"]), history, gaps,
+                      None if np.isnan(r_cap) else r_cap)
 
 
 __all__ = [

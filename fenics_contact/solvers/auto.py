@@ -129,6 +129,19 @@ class AutoStrategy(NewtonStrategy):
     #: this problem: the window's top until a failure there lowers it (nodal rule).
     _r_cap: float | None = None
 
+    @property
+    def r_cap(self) -> float | None:
+        """The top of the working r's window that this problem's failures set (E/h; None: none).
+
+        Kept along the path; a resumed run sets it from its checkpoint so
+        that its solves start at the r the uninterrupted run's would.
+        """
+        return self._r_cap
+
+    @r_cap.setter
+    def r_cap(self, value: float | None) -> None:
+        self._r_cap = None if value is None else float(value)
+
     def working_r(self) -> float:
         """The user's r clamped to the window (absolute, stress per length).
 
