@@ -135,3 +135,62 @@ def test_case_selection_by_name_and_group():
     assert [c.name for c in select(full_grid(), ["bar-steps1"])] == ["bar-steps1"]
     with pytest.raises(ValueError, match="groups"):
         select(full_grid(), ["nonsense"])
+
+
+STEEL_BLOCK = """
+[scene]
+name = "steel"
+dimension = 2
+[mesh]
+generator = "rectangle"
+size = [1.0, 0.5]
+cells = [8, 4]
+cell = "triangle"
+[material]
+law = "linear"
+E = 2.1e11
+nu = 0.3
+[obstacle]
+type = "plane"
+point = [0.0, 0.0]
+normal = [0.0, 1.0]
+[contact]
+tag = "bottom"
+[[dirichlet]]
+tag = "left"
+value = [0.0, "free"]
+[[dirichlet]]
+tag = "top"
+value = ["free", -0.01]
+[solver]
+steps = 2
+"""
+
+
+def test_a_scene_in_si_units_converges_with_the_default_tolerance(tmp_path):
+    """Steel in Pa (E h^(d-1) = 2.6e10): atol left out follows the forces.
+
+    An absolute 1e-8 lay below the round-off of forces of 1e9: the second
+    step was refused as cycling at a residual of 1e-6. Uniaxial plane strain:
+    the contact force is E / (1 - nu^2) times the strain 0.02 times the width.
+    """
+    from fenics_contact.runner import run_scene
+    from fenics_contact.scene.schema import load_scene
+
+    path = tmp_path / "steel.toml"
+    path.write_text(STEEL_BLOCK)
+    scene = load_scene(path)
+    assert not scene.solver.atol_given and scene.solver.atol == 1e-8
+    steps = run_scene(scene, tmp_path / "out", pictures=False).path.steps
+    assert [s.status for s in steps] == ["converged", "converged"]
+    exact = 2.1e11 / (1 - 0.3**2) * 0.02
+    assert abs(steps[-1].contact_force - exact) <= 1e-8 * exact
+    given = load_scene(_with_atol(path, 1e-3))
+    assert given.solver.atol_given and given.solver.atol == 1e-3
+
+
+def _with_atol(path, atol: float):
+    text = path.read_text().replace("[solver]\n", f"[solver]\natol = {atol}\n")
+    out = path.with_name("given.toml")
+    out.write_text(text)
+    return out

@@ -211,6 +211,7 @@ def read_solver(reader: _Reader) -> SolverSpec:
         steps=bounded("steps", 10, 1, MAX_STEPS),
         max_iterations=bounded("max_iterations", 50, 1, MAX_ITERATIONS),
         atol=reader.number("atol", 1e-8, positive=True),
+        atol_given="atol" in reader.table,
         rtol=reader.number("rtol", 1e-10) if "rtol" in reader.table else 1e-10,
         max_cutbacks=bounded("max_cutbacks", 4, 0, MAX_CUTBACKS),
         predictor=reader.choice("predictor", ("active-set", "extrapolate", "previous"),
