@@ -85,6 +85,29 @@ def test_frictional_3d_picture_has_a_stick_slip_panel(ball_friction):
     assert _image_width(out / "deformed.png") == 3 * 700
 
 
+def test_3d_friction_profile_is_drawn_against_the_distance_from_the_zone_centre(ball_friction):
+    """In 3D the nodes have no order along one axis: joined in x order they drew a sawtooth.
+
+    Each node is placed at its distance from the mu p weighted centre of the
+    zone (the ball presses the middle of the base): the limit mu p falls
+    with that distance, as the pressure under a ball does.
+    """
+    from fenics_contact.output.friction_plot import friction_profile, friction_profile_data
+
+    outcome, _ = ball_friction
+    data = friction_profile_data(outcome.problem)
+    (profile,) = data.values()
+    assert profile["axis"] == "r"
+    s, limit = profile["s"], profile["limit"]
+    assert np.all(np.diff(s) >= 0.0) and s[0] >= 0.0
+    touching = limit > 0.0
+    assert touching.sum() >= 5
+    assert s[touching].min() < 0.1 * s.max()  # the zone's centre sits on a pressed node
+    assert limit[np.argmin(s)] == pytest.approx(limit.max())  # the peak at the centre
+    friction_profile(outcome.problem, outcome.out / "friction.png", title="ball")
+    assert (outcome.out / "friction.png").stat().st_size > 0
+
+
 def test_render_in_3d_uses_the_same_contact_view(ball_friction):
     outcome, picture = ball_friction
     png, drawn = draw_step(outcome.out, field="von_mises", path=outcome.out / "vm.png")

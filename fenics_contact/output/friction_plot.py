@@ -1,13 +1,18 @@
 """Picture of the tangential traction against the Coulomb limit along each frictional contact.
 
 Matplotlib (Agg backend, no display). Collective: every process gives its
-owned contact nodes, process 0 draws one panel per frictional contact. The
-abscissa is the reference coordinate along which the contact surface
-extends most (x for a horizontal plane, y for a vertical wall). The traction
-drawn is the tangential traction the partner puts on the body (in 2D its
-component along the abscissa's axis, in 3D its magnitude) with the limits +-mu p;
-sticking nodes are drawn as filled dots, slipping nodes as crosses. A
-contact zone spanning under half the surface is shown alone.
+owned contact nodes, process 0 draws one panel per frictional contact.
+
+In 2D the abscissa is the reference coordinate along which the contact
+surface extends most (x for a horizontal plane, y for a vertical wall); the
+traction drawn is the tangential traction the partner puts on the body,
+its component along that axis, between the limits +-mu p. In 3D the nodes
+of a surface have no order along one coordinate (joined by lines in x
+order they drew a sawtooth): each node is drawn at its reference distance
+from the centre of the contact zone (the mu p weighted centroid of its
+nodes), with |tangential traction| beside mu p, as points. Sticking nodes
+are filled dots, slipping nodes crosses. A contact zone spanning under half
+the surface is shown alone.
 """
 
 from __future__ import annotations
@@ -30,9 +35,11 @@ AXES = "xyz"
 def friction_profile_data(problem: ContactProblem) -> dict[str, dict[str, np.ndarray]] | None:
     """Gathered nodal data of each frictional contact on process 0 (None elsewhere).
 
-    By contact name, sorted along the abscissa. Keys: s (abscissa, length),
-    axis (its name), traction (stress: along the axis in 2D, |tau| in 3D), limit (mu p
-    >= 0, stress), state (0 open, 1 stick, 2 slip).
+    By contact name, sorted along the abscissa. Keys: s (abscissa, length:
+    the reference coordinate in 2D, the distance from the zone's centre in
+    3D), axis (the coordinate's name; "r" in 3D), traction (stress: along
+    the axis in 2D, |tau| in 3D), limit (mu p >= 0, stress), state (0 open,
+    1 stick, 2 slip).
     """
     comm = problem.comm
     out: dict[str, dict[str, np.ndarray]] = {}
@@ -49,16 +56,34 @@ def friction_profile_data(problem: ContactProblem) -> dict[str, dict[str, np.nda
         # the traction on the body as a vector: the same sign for obstacles and pairs,
         # whatever way each contact's tangent frame turns
         vector, _ = contact.friction.tangential_fields()
-        traction = vector[:, axis] if problem.gdim == 2 else np.linalg.norm(vector, axis=1)
-        local = np.column_stack([coords[:, axis], traction, state.coulomb_limit,  # type: ignore
+        limit = np.asarray(state.coulomb_limit)  # type: ignore[attr-defined]
+        if problem.gdim == 2:
+            traction, s = vector[:, axis], coords[:, axis]
+        else:
+            traction = np.linalg.norm(vector, axis=1)
+            s = np.linalg.norm(coords - _zone_centre(comm, coords, limit), axis=1)
+        local = np.column_stack([s, traction, limit,
                                  state.node_state])  # type: ignore[attr-defined]
         parts = comm.gather(local, root=0)
         if comm.rank == 0:
             data = np.vstack(parts)
             data = data[np.argsort(data[:, 0], kind="stable")]
-            out[contact.name] = {"s": data[:, 0], "axis": AXES[axis], "traction": data[:, 1],
+            out[contact.name] = {"s": data[:, 0],
+                                 "axis": AXES[axis] if problem.gdim == 2 else "r",
+                                 "traction": data[:, 1],
                                  "limit": data[:, 2], "state": data[:, 3]}
     return out if comm.rank == 0 else None
+
+
+def _zone_centre(comm, coords: np.ndarray, limit: np.ndarray) -> np.ndarray:
+    """The mu p weighted centroid of the contact nodes (their plain centroid if none carry)."""
+    weight = np.maximum(limit, 0.0)
+    sums = comm.allreduce(np.concatenate([weight @ coords, [weight.sum()],
+                                          coords.sum(axis=0), [len(coords)]]))
+    d = coords.shape[1]
+    if sums[d] > 0.0:
+        return sums[:d] / sums[d]
+    return sums[d + 1:2 * d + 1] / max(sums[-1], 1.0)
 
 
 def contact_window(s: np.ndarray, touching: np.ndarray) -> tuple[float, float] | None:
@@ -86,6 +111,9 @@ def friction_profile(problem: ContactProblem, path: Path, title: str = "") -> No
         return
     fig, axes = plt.subplots(len(profiles), 1, figsize=(7, 3.8 * len(profiles)), squeeze=False)
     for ax, (name, data) in zip(axes[:, 0], profiles.items(), strict=True):
+        if data["axis"] == "r":
+            _radial_panel(ax, name, data, several=len(profiles) > 1)
+            continue
         s = data["s"]
         ax.fill_between(
             s, -data["limit"], data["limit"], color="#dddddd", label="Coulomb disc |t| <= mu p"
@@ -109,3 +137,21 @@ def friction_profile(problem: ContactProblem, path: Path, title: str = "") -> No
     if title:
         axes[0, 0].set_title(title, fontsize=10)
     save_figure(fig, path)
+
+
+def _radial_panel(ax, name: str, data: dict[str, np.ndarray], several: bool) -> None:
+    """3D: |t| and mu p of every node against its distance from the zone's centre."""
+    s, traction, limit = data["s"], data["traction"], data["limit"]
+    ax.plot(s, limit, ".", color="#888888", ms=3, label="Coulomb limit mu p")
+    stick = data["state"] == STICK
+    slip = data["state"] == SLIP
+    ax.plot(s[stick], traction[stick], "o", color="#1f77b4", ms=4, label="|t|, stick")
+    ax.plot(s[slip], traction[slip], "x", color="#d62728", ms=5, label="|t|, slip")
+    window = contact_window(s, (limit > 0) | (data["state"] != 0))
+    if window is not None:
+        ax.set_xlim(0.0, window[1])
+    ax.set_xlabel("reference distance from the centre of the contact zone"
+                  + (f" '{name}'" if several else ""))
+    ax.set_ylabel("|tangential traction| on the body")
+    ax.set_ylim(bottom=0.0)
+    ax.legend(fontsize=8)
