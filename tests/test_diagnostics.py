@@ -67,3 +67,21 @@ def test_iteration_limit():
     m = ConvergenceMonitor(SolverSettings(max_iterations=3))
     assert feed(m, [1.0, 0.9, 0.8, 0.7, 0.6]) == Status.MAX_ITERATIONS
     assert m.iterations == 3
+
+
+def test_a_node_inside_its_own_neighbourhood_is_told_what_helps():
+    """Lowering the neighbourhood is advised only where it is above one facet size."""
+    from types import SimpleNamespace
+
+    from fenics_contact.solvers.diagnostics import _inside_target_cause
+
+    def cause(neighbourhood: float) -> str:
+        pair = SimpleNamespace(neighbourhood=neighbourhood,
+                               inside_own_neighbourhood=lambda depth: True)
+        return _inside_target_cause(SimpleNamespace(pair=pair), 1e-3)
+
+    assert "lower [[pair]] neighbourhood (e.g. 1)" in cause(3.0)
+    folded = cause(1.0)
+    assert "lower [[pair]] neighbourhood" not in folded
+    assert "folds onto itself within about one facet size" in folded
+    assert "tag the surface on either side of the fold apart" in folded

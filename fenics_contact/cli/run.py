@@ -220,7 +220,7 @@ def _advice(scene: Scene, status: str, overlap: str | None = None, message: str 
         return ""
     from fenics_contact.solvers.diagnostics import NO_SOLVER_MENDS
 
-    if "cannot help: lower [[pair]] neighbourhood" in message or NO_SOLVER_MENDS in message:
+    if "the self-contact search never pairs it with" in message or NO_SOLVER_MENDS in message:
         return "."
     method = scene.solver.method
     tips = []

@@ -359,11 +359,17 @@ def _inside_target_cause(contact, depth: float) -> str:
     pair = getattr(contact, "pair", None)
     inside_own = getattr(pair, "inside_own_neighbourhood", None)
     if inside_own is not None and inside_own(depth):
-        return (f"a striker node inside target facets of its own neighbourhood "
+        what = (f"a striker node inside target facets of its own neighbourhood "
                 f"({pair.neighbourhood:g} facet sizes along the surface), which the "
                 "self-contact search never pairs it with, so smaller steps or another method "
-                "cannot help: lower [[pair]] neighbourhood (e.g. 1), or pair the two "
-                'surfaces with discretisation = "mortar"')
+                "cannot help: ")
+        if pair.neighbourhood > 1.0:
+            return what + ("lower [[pair]] neighbourhood (e.g. 1), or pair the two "
+                           'surfaces with discretisation = "mortar"')
+        return what + ("the surface folds onto itself within about one facet size, which "
+                       "no neighbourhood excludes less; refine the mesh where it folds, or "
+                       "tag the surface on either side of the fold apart and pair the two "
+                       'tags (self_contact = true, discretisation = "mortar")')
 
     if isinstance(contact, MortarContact):
         return ("a striker node of the mortar pair has passed through the target deeper than "
