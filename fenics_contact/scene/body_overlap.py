@@ -185,7 +185,11 @@ def warn_body_overlap(scene: Scene, problem: ContactProblem,
         declared = found.contact in {p.name for p in scene.pairs}
         label = f"[[pair]] {found.contact!r}" if declared else \
             f"[pairing] automatic contact {found.contact!r}"
-        if not declared:
+        if declared and scene.solver.method == "penalty":
+            fix = ("The penalty method lets a pair's surfaces overlap by about the pressure "
+                   "over r: raise the pair's r, or use gnrm or auto, which hold the gap "
+                   "exactly.")
+        elif not declared:
             fix = ("The pair holds its striker nodes out of the target only: declare these two "
                    "bodies as a [[pair]] (its striker and target of your choosing, or "
                    'discretisation = "mortar"), which [pairing] then leaves to it.')
