@@ -272,20 +272,24 @@ def _replace_earlier_run(comm: MPI.Comm, out: Path) -> None:
 LOOSE_ATOL = 1e-5
 
 
+#: atol a scene leaves out is at least this times its force unit E h^(d-1).
+SCENE_FORCE_ATOL = 1e-12
+
+
 def scene_atol(scene: Scene, problem: ContactProblem) -> Scene:
     """The scene with atol following the forces when the scene does not give it.
 
     The residual is in force units: with a large E (steel in Pa: E h^(d-1)
     about 1e10) an absolute 1e-8 lies below the round-off of the forces and
     no step converges (a block on a plane, E = 2.1e11, was refused as
-    cycling at 1e-6). Left out, atol is max(1e-8, 1e-10 E h^(d-1)); the
-    shipped scenes (E h^(d-1) <= 100) keep 1e-8.
+    cycling at 1e-6). Left out, atol is max(1e-8, 1e-12 E h^(d-1)); every
+    shipped scene (E h^(d-1) <= 1e4) keeps 1e-8.
     """
-    from fenics_contact.model.scaling import DEFAULT_FORCE_RTOL, force_scale
+    from fenics_contact.model.scaling import force_scale
 
     if scene.solver.atol_given:
         return scene
-    atol = max(scene.solver.atol, DEFAULT_FORCE_RTOL * force_scale(problem))
+    atol = max(scene.solver.atol, SCENE_FORCE_ATOL * force_scale(problem))
     return replace(scene, solver=replace(scene.solver, atol=atol))
 
 

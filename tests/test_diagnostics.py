@@ -85,3 +85,17 @@ def test_a_node_inside_its_own_neighbourhood_is_told_what_helps():
     assert "lower [[pair]] neighbourhood" not in folded
     assert "folds onto itself within about one facet size" in folded
     assert "tag the surface on either side of the fold apart" in folded
+
+
+def test_a_two_cycle_whose_low_level_drifts_is_cycling():
+    """A 3D frictional mortar pair at r = 10 E/h: 1.24e-2 / 1.41e-3, the low side 1 % lower
+    a cycle. A new minimum kept appearing, so 48 iterations passed before the step escaped
+    by itself; a zigzag of two levels that barely move is a 2-cycle."""
+    values = [0.3] + [v for k in range(30) for v in (1.24e-2, 1.41e-3 * 0.99**k)]
+    m = ConvergenceMonitor(SolverSettings(cycle_window=12, max_iterations=100))
+    assert feed(m, values) == Status.CYCLING
+    assert m.iterations <= 14
+    # a zigzag that makes progress is not one
+    falling = [0.3] + [v for k in range(30) for v in (1.24e-2 * 0.7**k, 1.41e-3 * 0.7**k)]
+    m = ConvergenceMonitor(SolverSettings(cycle_window=12, max_iterations=40))
+    assert feed(m, falling) == Status.MAX_ITERATIONS

@@ -255,7 +255,7 @@ KEY_DOCS: dict[str, dict[str, KeyDoc]] = {
         "max_iterations": KeyDoc("integer >= 1", "Newton iterations allowed in one load step.",
                                  field="SolverSpec.max_iterations"),
         "atol": KeyDoc("number > 0", "Absolute tolerance on the static residual (left "
-                       "out: 1e-8, or 1e-10 E h^(d-1) where that is larger, h the contact "
+                       "out: 1e-8, or 1e-12 E h^(d-1) where that is larger, h the contact "
                        "facet size).", "F", field="SolverSpec.atol"),
         "rtol": KeyDoc("number", "Tolerance relative to the first residual of a solve "
                        "(0 disables).", field="SolverSpec.rtol"),

@@ -153,7 +153,7 @@ class SolverSpec(SolverSettings):
     """Stopping rules (:class:`SolverSettings`) plus strategy and load stepping."""
 
     rtol: float = 1e-10
-    #: Whether the scene gives atol; if not, the run raises it to 1e-10 E h^(d-1) where
+    #: Whether the scene gives atol; if not, the run raises it to 1e-12 E h^(d-1) where
     #: that is larger (a large E in SI units: :func:`fenics_contact.runner.scene_atol`).
     atol_given: bool = False
     method: str = "gnrm"
