@@ -99,3 +99,18 @@ def test_a_two_cycle_whose_low_level_drifts_is_cycling():
     falling = [0.3] + [v for k in range(30) for v in (1.24e-2 * 0.7**k, 1.41e-3 * 0.7**k)]
     m = ConvergenceMonitor(SolverSettings(cycle_window=12, max_iterations=40))
     assert feed(m, falling) == Status.MAX_ITERATIONS
+
+
+def test_a_mortar_node_inside_but_within_reach_is_not_said_to_be_past_the_search():
+    """A crushed ring's fold (0.0179 inside, reach 0.059): no facet it may pair with."""
+    from types import SimpleNamespace
+
+    from fenics_contact.model.mortar import MortarContact
+    from fenics_contact.solvers.diagnostics import _inside_target_cause
+
+    contact = MortarContact.__new__(MortarContact)
+    contact.mortar = SimpleNamespace(reach=0.059)
+    near = _inside_target_cause(contact, 3e-4, 0.0179)
+    assert "finds no target facet it may pair with" in near
+    assert "deeper than its segment search reaches" not in near
+    assert "deeper than its segment search reaches" in _inside_target_cause(contact, 3e-4, 0.1)

@@ -365,7 +365,7 @@ def _signorini_violation(contact, settings: SolverSettings, E: float) -> str | N
     if violation is None and two_body and inside > settings.surface_tol * h:
         violation = (f"penetration into the target surface {inside:.3g} > surface_tol * h = "
                      f"{settings.surface_tol:g} * {h:.3g} "
-                     f"({_inside_target_cause(contact, settings.surface_tol * h)})")
+                     f"({_inside_target_cause(contact, settings.surface_tol * h, inside)})")
     return violation
 
 
@@ -381,10 +381,11 @@ def _deepest_is_held(contact, gap: np.ndarray) -> bool:
     return bool(contact.comm.bcast(held, root=rank)) and depth > 0.0
 
 
-def _inside_target_cause(contact, depth: float) -> str:
+def _inside_target_cause(contact, depth: float, inside: float | None = None) -> str:
     """Why a striker node of a converged iterate can lie inside the target, per discretisation.
 
-    ``depth``: the depth that counts (length). Collective.
+    ``depth``: the depth that counts (length); ``inside``: the node's depth, when
+    known (length). Collective.
     """
     from fenics_contact.model.mortar import MortarContact
 
@@ -404,6 +405,15 @@ def _inside_target_cause(contact, depth: float) -> str:
                        'tags (self_contact = true, discretisation = "mortar")')
 
     if isinstance(contact, MortarContact):
+        reach = contact.mortar.reach
+        if inside is not None and inside < reach:
+            return (f"a striker node of the mortar pair {inside / reach:.2g} of its search "
+                    "reach inside the target finds no target facet it may pair with: facets "
+                    "at more than about 78 degrees to its own are not paired, nor, where the "
+                    "striker and target share a vertex (the fold of a surface closing on "
+                    "itself), the facets that hold the node or its neighbours; refine the "
+                    "mesh where the surfaces fold, or end the striker and target tags away "
+                    "from the fold")
         return ("a striker node of the mortar pair has passed through the target deeper than "
                 "its segment search reaches (2 facet sizes): its weighted gap finds no target "
                 "facet and reads open; pushed through by too large a step, or the bodies "
