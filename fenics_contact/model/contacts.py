@@ -38,8 +38,9 @@ class SlotUse(NamedTuple):
 
     ``wanted``: what a striker support overlaps where the surfaces first meet
     (chosen at the start); ``now`` and ``most``: the most target facets one
-    striker node in contact overlapped, in the current state and at any
-    search of the run. Beyond ``slots`` the weighted gap leaves the rest of
+    striker node in contact overlapped, in the current state and in any
+    converged state of the run (an iterate far from the answer may stretch
+    a facet over many). Beyond ``slots`` the weighted gap leaves the rest of
     the support out.
     """
 
@@ -305,6 +306,9 @@ class Contact:
         peak = self.comm.allreduce(float(np.max(-pressure, initial=0.0)), op=MPI.MAX)
         pressure[pressure > -max(1e-12 * peak, 1e-14 * self.modulus)] = 0.0
         return pressure
+
+    def note_converged(self) -> None:
+        """Runs after each converged increment (default: nothing)."""
 
     def slot_use(self) -> SlotUse | None:
         """A 2D mortar pair's slots and how many target facets its nodes overlapped; else None."""

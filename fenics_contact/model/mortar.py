@@ -128,7 +128,8 @@ class MortarTransfer:
         self.search_count = 0
         self.overflow = 0
         #: The most target facets one striker node near contact overlapped: at the last
-        #: search, and at any search so far (owned nodes, this rank).
+        #: search, and in any converged state so far (:meth:`MortarContact.note_converged`;
+        #: an iterate far from the answer may stretch a facet over many; owned, this rank).
         self.overlaps_now = 0
         self.most_overlaps = 0
         self._searched_u: np.ndarray | None = None
@@ -148,7 +149,6 @@ class MortarTransfer:
         self.overflow = int(np.sum(((dropped > 0) & near)[: self.n_owned]))
         counts = np.sum(scores > 0.0, axis=1)[: self.n_owned][near[: self.n_owned]]
         self.overlaps_now = int(counts.max(initial=0))
-        self.most_overlaps = max(self.most_overlaps, self.overlaps_now)
         self.search_count += 1
         self._picked = (facet, used)
         fv = self.target.facet_vertex
@@ -387,6 +387,11 @@ class MortarContact(Contact):
         from fenics_contact.model.mortar3d import ENGAGED
 
         return gaps <= ENGAGED * self.mortar.open_gap
+
+    def note_converged(self) -> None:
+        """2D: the overlaps of the state just converged count towards :meth:`slot_use`."""
+        if self.gdim == 2:
+            self.mortar.most_overlaps = max(self.mortar.most_overlaps, self.mortar.overlaps_now)
 
     def slot_use(self) -> SlotUse | None:
         """2D: the slots and the most target facets a striker node overlapped (collective)."""

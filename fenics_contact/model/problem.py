@@ -269,6 +269,8 @@ class ContactProblem(FrictionalContacts):
         regularised-stick history); AL methods already hold it there, and so
         does ``auto`` after a penalty warm start (it only borrows the system).
         """
+        for c in self.contacts:
+            c.note_converged()
         if not self.frictional:
             return
         if not self.multiplier_is_pressure:

@@ -42,11 +42,12 @@ def warn_slots_capped(problem: ContactProblem) -> None:
 
 def slot_shortfall(problem: ContactProblem) -> str | None:
     """The fix when a striker node overlapped more target facets than its slots (collective)."""
-    short = [u for u in problem.slot_uses() if u.most > u.slots]
+    short = [u for u in problem.slot_uses() if max(u.now, u.most) > u.slots]
     if not short:
         return None
-    return "; ".join(f"mortar pair {u.contact!r}: a striker node overlapped {u.most} target "
-                     f"facets with {u.slots} slots ({_fix(u.most + 1)})" for u in short)
+    return "; ".join(f"mortar pair {u.contact!r}: a striker node overlapped "
+                     f"{max(u.now, u.most)} target facets with {u.slots} slots "
+                     f"({_fix(max(u.now, u.most) + 1)})" for u in short)
 
 
 def warn_slot_overflow(problem: ContactProblem) -> None:
@@ -54,19 +55,20 @@ def warn_slot_overflow(problem: ContactProblem) -> None:
     from fenics_contact.scene.checks import SceneWarning
 
     for use in problem.slot_uses():
-        if use.most <= use.slots:
+        most = max(use.now, use.most)
+        if most <= use.slots:
             continue
         if use.now > use.slots:
             what = (f"in the last state a striker node in contact overlaps {use.now} target "
                     f"facets with {use.slots} slots: its weighted gap leaves part of its "
                     "support out, so the pressures and gaps there are not the mortar answer")
         else:
-            what = (f"during the run a striker node overlapped up to {use.most} target facets "
-                    f"with {use.slots} slots (not in the last state); its weighted gap jumped "
-                    "as the kept facets changed, which costs Newton iterations")
+            what = (f"in an earlier converged state a striker node overlapped up to "
+                    f"{use.most} target facets with {use.slots} slots (not in the last "
+                    "state); its weighted gap left part of its support out there")
         warnings.warn(SceneWarning(
             f"mortar pair {use.contact!r}: {what}. The target is finer there than where "
-            f"the surfaces first met: {_fix(use.most + 1)}."), stacklevel=2)
+            f"the surfaces first met: {_fix(most + 1)}."), stacklevel=2)
 
 
 __all__ = ["slot_shortfall", "warn_slot_overflow", "warn_slots_capped"]
