@@ -67,8 +67,8 @@ def warn_slot_overflow(problem: ContactProblem) -> None:
                     f"{use.most} target facets with {use.slots} slots (not in the last "
                     "state); its weighted gap left part of its support out there")
         warnings.warn(SceneWarning(
-            f"mortar pair {use.contact!r}: {what}. The target is finer there than where "
-            f"the surfaces first met: {_fix(most + 1)}."), stacklevel=2)
+            f"mortar pair {use.contact!r}: {what}. The target is finer there than the "
+            f"slots allow: {_fix(most + 1)}."), stacklevel=2)
 
 
 __all__ = ["slot_shortfall", "warn_slot_overflow", "warn_slots_capped"]
