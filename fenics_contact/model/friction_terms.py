@@ -215,15 +215,24 @@ class CoulombFriction:
             if not symmetric:
                 self._refuse_oblique_hold(nodes[free_gap[nodes]], axis, name)
             if symmetric:
-                worst = float(np.min(along[np.arange(nodes.size), j], initial=1.0))
-                worst = self.comm.allreduce(worst, op=MPI.MIN)
+                cosines = along[np.arange(nodes.size), j]
+                k_worst = int(np.argmin(cosines)) if nodes.size else -1
+                local = float(cosines[k_worst]) if nodes.size else 1.0
+                where = (self.contact.nodal_coordinates()[nodes[k_worst], : self.gdim]
+                         if nodes.size else np.zeros(self.gdim))
+                worst, rank = self.comm.allreduce((local, self.comm.rank), op=MPI.MINLOC)
+                where = self.comm.bcast(where, root=rank)
                 if worst < 1.0 - 1e-8:
+                    at = ", ".join(f"{c:.4g}" for c in where)
                     raise ValueError(
                         f"A symmetry plane (u_{'xyz'[axis]} = 0 on a plane normal to "
                         f"{'xyz'[axis]}) crosses the frictional contact surface where the "
-                        f"contact normal is not in the plane (|t . e_{'xyz'[axis]}| = "
-                        f"{worst:.3g}); a symmetry cut needs the contact normal in the plane "
-                        "there.")
+                        f"contact's frame is not aligned with it (|t . e_{'xyz'[axis]}| = "
+                        f"{worst:.3g} at the contact node ({at}), a frame taken from the "
+                        "nearest facet of the partner at the start); a symmetry cut needs "
+                        "the contact normal in the plane there. If that node is far from "
+                        "its partner and never touches, end the contact's facet tag before "
+                        "the plane; otherwise model the whole body across the plane.")
             # a held axis across the frame leaves the slip free along the tangents: no
             # zero Jacobian row, nothing to treat
             constrained[nodes[aligned], j[aligned]] = True
