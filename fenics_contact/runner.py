@@ -151,7 +151,7 @@ def _summary(scene: Scene, record: RunRecord, used: dict[str, dict] | None = Non
     }
 
 
-_FRICTION_KEYS = ("tangential_force", "stick_count", "slip_count")
+_FRICTION_KEYS = ("tangential_force", "tangential_magnitude", "stick_count", "slip_count")
 
 
 def _shape(spec) -> dict:

@@ -42,7 +42,10 @@ def test_tradeoff_command_on_a_scene_writes_json_csv_table_and_plot(tmp_path):
     assert "| bar | paper_ex2 | Auto |" in table
     # GNRM converged at r = 1 E/h only: the reference's own point, and marked so
     gnrm = next(line for line in table.splitlines() if "| GNRM |" in line)
-    assert "(the reference's own method and r)" in gnrm
+    assert "(the reference's own path)" in gnrm
+    # auto at r = 1 and 1e10 E/h works at r = 1 E/h: the reference to round-off
+    auto = next(line for line in table.splitlines() if "| Auto |" in line)
+    assert "(the reference's answer to round-off)" in auto
     assert (tmp_path / "tradeoff.png").stat().st_size > 10_000
 
 
@@ -113,17 +116,17 @@ def test_stability_two_body_friction_records_coulomb_ratio_and_reference(tmp_pat
     rows = {(r["case"], r["method"]): r for r in read_csv(tmp_path / "stability.csv")}
     assert {"mu", "tangential_force", "ft_ratio", "reference", "reference_deviation",
             "reference_reached"} <= set(rows[("blocks-mu0.3", "gnrm")])
-    for method in ("gnrm", "auto"):  # the reference itself; full slip: F_t = mu N (tilted facets)
+    for method in ("gnrm", "auto"):  # the reference itself; full slip: int |t| = mu N
         row = rows[("blocks-mu0.3", method)]
         assert row["status"] == "converged" and float(row["mu"]) == 0.3
-        assert float(row["ft_ratio"]) == pytest.approx(0.99998, abs=1e-5)
+        assert float(row["ft_ratio"]) == pytest.approx(1.0, abs=1e-12)
         assert row["reference"] == "gnrm r=1" and row["reference_reached"] == "True"
         assert float(row["reference_deviation"]) < 1e-12
     gnrm, auto = rows[("blocks-r1e12", "gnrm")], rows[("blocks-r1e12", "auto")]
     assert gnrm["status"] == "diverged" and gnrm["reference_reached"] == "False"
     assert auto["status"] == "converged" and auto["reference_reached"] == "True"
     assert float(auto["reference_deviation"]) < 1e-10
-    assert float(auto["ft_ratio"]) == pytest.approx(0.99998, abs=1e-5)
+    assert float(auto["ft_ratio"]) == pytest.approx(1.0, abs=1e-10)
 
 
 def test_study_beside_another_scene_with_relative_r_fills_the_table(tmp_path):
@@ -145,7 +148,9 @@ def test_sweeps_on_a_frictional_scene_with_several_contacts(tmp_path):
     ``tradeoff`` used to stop with AttributeError (it read stick/slip from
     the first contact, the floor); ``stability`` divided the wall's F_t by
     mu times every contact's N (0.085). Both now take F_t / (mu N) over the
-    frictional contacts: the wall slips at 0.98 of its limit.
+    frictional contacts, F_t as int |t| dA: every wall node slips, so 1; the
+    vector sum of the tractions, whose directions differ along the wall, is
+    0.98 of mu N (read before as a friction error of 2 %).
     """
     code = main(["tradeoff", str(SCENES / "block_floor_wall.toml"), "--methods", "gnrm",
                  "--r", "1", "--repeats", "1", "--out", str(tmp_path / "trade")])
@@ -160,8 +165,10 @@ def test_sweeps_on_a_frictional_scene_with_several_contacts(tmp_path):
     wall = record["steps"][-1]["contacts"]["wall"]
     assert record["mus"] == {"wall": 0.2}
     assert float(row["ft_ratio"]) == pytest.approx(
-        wall["tangential_force"] / (0.2 * wall["normal_force"]), rel=1e-12)
-    assert float(row["ft_ratio"]) == pytest.approx(0.98138, abs=1e-4)
+        wall["tangential_magnitude"] / (0.2 * wall["normal_force"]), rel=1e-12)
+    assert float(row["ft_ratio"]) == pytest.approx(1.0, abs=1e-10)
+    assert wall["tangential_force"] / (0.2 * wall["normal_force"]) == pytest.approx(
+        0.98138, abs=1e-4)
 
 
 @pytest.mark.parametrize("contact_set", ["sign", "exact"])

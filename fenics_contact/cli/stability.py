@@ -133,10 +133,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         "an error (an exception, not a solver status)."
         " Each load step starts from the last converged state (predictor \"previous\", "
         "whatever the scene says), so that every method starts alike, and each Newton "
-        "step takes its contact set by the sign rule (--contact-set): iteration counts "
-        "match `run` with predictor = \"previous\" and contact_set = \"sign\" (a "
-        "scene's default contact_set = \"exact\" may converge where a run here does "
-        "not: --contact-set exact).",
+        "step takes its contact set by the sign rule (--contact-set); the stopping "
+        "tolerance is max(--force-rtol E h^(d-1), the round-off floor at r), not the "
+        "scene's atol: iteration counts match `run` with predictor = \"previous\", "
+        "contact_set = \"sign\" and the atol written in stability.json (a scene's "
+        "default contact_set = \"exact\" may converge where a run here does not: "
+        "--contact-set exact).",
     )
     cmd.add_argument("scenes", nargs="+", type=Path, help="scene files (.toml)")
     cmd.add_argument("--r", type=floats, default=list(EXTREME_R),

@@ -41,17 +41,25 @@ def study_and_write(subjects: Sequence, args: argparse.Namespace) -> int:
     first the one studied. Writes study.json, study.csv, table.md and the
     residual and iteration pictures into ``args.out``.
     """
+    from mpi4py import MPI
+
     from fenics_contact.output.io import write_csv, write_json
     from fenics_contact.output.plotting import iterations_against_r, residual_histories
     from fenics_contact.solvers.diagnostics import SolverSettings
     from fenics_contact.sweeps.study import comparison_table, paper_table, probe_line, run_study
+
+    root = MPI.COMM_WORLD.rank == 0  # every process runs the study; one speaks and writes
+
+    def say(*text, **kwargs) -> None:
+        if root:
+            print(*text, **kwargs)
 
     first = subjects[0]
     out: Path = args.out
     settings = SolverSettings(atol=args.tol, max_iterations=args.max_iterations)
 
     def show(rec) -> None:
-        print(
+        say(
             f"  {rec.method:8s} r = {rec.r:<10g} {rec.status:15s} iterations {rec.iterations:4d}"
             f"  updates {rec.updates:4d}  {rec.wall_s:6.2f} s",
             flush=True,
@@ -64,33 +72,34 @@ def study_and_write(subjects: Sequence, args: argparse.Namespace) -> int:
             exact=subject.exact,
         )
 
-    print(f"Study {first.label}: methods {','.join(args.methods)}; r = {args.r}", flush=True)
+    say(f"Study {first.label}: methods {','.join(args.methods)}; r = {args.r}", flush=True)
     records = study(first)
     table = paper_table(records, limit=args.max_iterations, relative=args.relative)
-    print()
-    print(table)
+    say()
+    say(table)
     sources: list = [(first.label, records)]
     if first.published is not None:
         sources.append(("paper", first.published))
     for other in subjects[1:]:
-        print(f"\nStudy {other.label} (beside {first.label})", flush=True)
+        say(f"\nStudy {other.label} (beside {first.label})", flush=True)
         sources.append((other.label, study(other)))
     if len(sources) > 1:
         table = comparison_table(sources, args.r, args.methods, limit=args.max_iterations,
                                  relative=args.relative)
-        print(f"\n{first.label} beside {', '.join(label for label, _ in sources[1:])}:\n")
-        print(table)
-        print()
+        say(f"\n{first.label} beside {', '.join(label for label, _ in sources[1:])}:\n")
+        say(table)
+        say()
     for label, source in sources:
         if not isinstance(source, Mapping) and "penalty" in args.methods:
             if any(math.isfinite(rec.probe) for rec in source):
-                print(f"Penalty probe ({label}): {probe_line(source)}")
-    write_json(out / "study.json", [r.to_dict() for r in records])
-    write_csv(out / "study.csv", [r.row() for r in records])
-    (out / "table.md").write_text(table + "\n")
-    residual_histories(records, out / "residuals.png")
-    iterations_against_r(records, out / "iterations.png")
-    print(f"\nWrote {out}/study.json, study.csv, table.md, residuals.png, iterations.png")
+                say(f"Penalty probe ({label}): {probe_line(source)}")
+    if root:
+        write_json(out / "study.json", [r.to_dict() for r in records])
+        write_csv(out / "study.csv", [r.row() for r in records])
+        (out / "table.md").write_text(table + "\n")
+        residual_histories(records, out / "residuals.png")
+        iterations_against_r(records, out / "iterations.png")
+    say(f"\nWrote {out}/study.json, study.csv, table.md, residuals.png, iterations.png")
     return 0
 
 

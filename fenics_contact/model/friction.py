@@ -277,6 +277,10 @@ class FrictionalContactState(ContactState):
     node_state: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int8))
     tangential_magnitude: float = 0.0
 
+    def summary(self) -> dict[str, float | int]:
+        """The normal summary plus ``tangential_magnitude`` (for a step's record)."""
+        return {**super().summary(), "tangential_magnitude": self.tangential_magnitude}
+
 
 def check_friction(mu: float, tangential_r_max: float | None) -> None:
     """Raise ValueError naming a bad friction coefficient or tangential cap."""
