@@ -293,6 +293,35 @@ def scene_atol(scene: Scene, problem: ContactProblem) -> Scene:
     return replace(scene, solver=replace(scene.solver, atol=atol))
 
 
+#: Springs of a stabilised body carrying more than this share of its load are warned.
+STABILISATION_SHARE = 1e-3
+
+
+def warn_stabilisation(scene: Scene, problem: ContactProblem, path: RunRecord) -> None:
+    """Warn where a stabilised body's springs carry a share of the load (collective).
+
+    The load: the largest support reaction or contact force of the last step.
+    """
+    from fenics_contact.scene.checks import SceneWarning
+
+    forces = problem.stabilisation_forces()
+    if not forces or not path.steps:
+        return
+    last = path.steps[-1]
+    scale = max([abs(last.contact_force)] + [
+        float(np.linalg.norm(v)) for k, v in (last.reactions or {}).items()
+        if not k.startswith("stabilise ")] + [
+        abs(c.get("normal_force", 0.0)) for c in (last.contacts or {}).values()])
+    for name, force in forces.items():
+        size = float(np.linalg.norm(force))
+        if size > STABILISATION_SHARE * scale:
+            warnings.warn(SceneWarning(
+                f"{scene.path.name}: [[body]] {name!r}: its stabilising springs carry "
+                f"{size:.3g}, {size / max(scale, 1e-300):.2%} of the largest force of the last "
+                "step: they hold more than rigid motions; lower stabilise, or hold the body "
+                "by a support."), stacklevel=2)
+
+
 def _warn_loose_tolerance(scene: Scene, problem: ContactProblem) -> None:
     """Warn when atol (absolute, force units) is not small against the problem's forces.
 
@@ -391,6 +420,8 @@ def run_scene(
     def finished(step: StepRecord) -> None:
         watch.step(step.step, step.load_factor)
         step.reactions = problem.support_reactions()
+        for name, force in problem.stabilisation_forces().items():  # weak springs: a support
+            step.reactions[f"stabilise {name}"] = force.tolist()
         step.reaction_total = problem.support_total()
         writer.write(step.load_factor)
         history = strategy.history if isinstance(strategy, Extrapolated) else []
@@ -423,6 +454,7 @@ def run_scene(
         path.steps[-1].reaction_total = problem.support_total()
     with _kept(notes):
         warn_slot_overflow(problem)  # also when no step converged: it may be why
+        warn_stabilisation(scene, problem, path)
     if any(s.status == "converged" for s in path.steps):
         # checks of the answer; with no load step finished the state is the start,
         # which the checks before the first step have described

@@ -32,11 +32,16 @@ class Body:
         name: label used in outputs.
         tag: its cell tag in the mesh (None: every cell, a one-body mesh).
         material: its constitutive law.
+        stabilise: weak springs tying every point to its reference position, of
+            stiffness stabilise E / L^2 per unit volume (L the diagonal of the body's
+            bounding box): they hold rigid motions that nothing holds before the load
+            presses the body (a round seal that only friction holds). 0: none.
     """
 
     name: str
     tag: int | None
     material: Elastic
+    stabilise: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -237,6 +242,8 @@ class Solid:
             self._dx[b.tag] = dx(metadata=metadata) if b.tag is None else dx(
                 b.tag, metadata=metadata
             )
+        #: each stabilised body's spring stiffness (stress per length^2), by tag
+        self._spring = self._springs(cell_tags)
         self._internal_form: fem.Form | None = None
         # det F at the energy's degree-2 points: every load step checks it (compiled with
         # the other forms, not inside the first step)
@@ -246,10 +253,46 @@ class Solid:
 
     # -- energy -------------------------------------------------------------------
     def strain_energy(self) -> ufl.Form:
-        """Sum over the bodies of int psi_b dV (energy; per unit thickness in 2D)."""
+        """Sum over the bodies of int psi_b dV (energy; per unit thickness in 2D).
+
+        A stabilised body adds its springs' energy int k |u|^2 / 2 dV
+        (:meth:`stabilisation_force`).
+        """
         terms = [b.material.strain_energy(self.u, self._moduli[b.tag]) * self._dx[b.tag]
                  for b in self.bodies]
+        terms += [0.5 * self._spring[b.tag] * ufl.dot(self.u, self.u) * self._dx[b.tag]
+                  for b in self.bodies if b.tag in self._spring]
         return sum(terms[1:], terms[0])
+
+    def stabilisation_force(self, body: str) -> np.ndarray:
+        """The force the springs of a stabilised body put on it, int -k u dV (collective).
+
+        Force (per unit thickness in 2D); zeros for a body without springs.
+        """
+        b = next(b for b in self.bodies if b.name == body)
+        if b.tag not in self._spring:
+            return np.zeros(self.gdim)
+        k = self._spring[b.tag]
+        return np.array([self.comm.allreduce(fem.assemble_scalar(fem.form(
+            -k * self.u[i] * self._dx[b.tag])), op=MPI.SUM) for i in range(self.gdim)])
+
+    def _springs(self, cell_tags: mesh.MeshTags | None) -> dict:
+        """Each stabilised body's spring stiffness stabilise E / L^2 (a Constant, by tag)."""
+        out = {}
+        tdim = self.domain.topology.dim
+        for b in self.bodies:
+            if b.stabilise <= 0.0:
+                continue
+            cells = (np.arange(self.domain.topology.index_map(tdim).size_local, dtype=np.int32)
+                     if b.tag is None else cell_tags.find(b.tag))
+            nodes = np.unique(self.domain.geometry.dofmaps[0][cells].reshape(-1))
+            x = self.domain.geometry.x[nodes, : self.gdim]
+            lo = self.comm.allreduce(np.min(x, axis=0, initial=np.inf), op=MPI.MIN)
+            hi = self.comm.allreduce(np.max(x, axis=0, initial=-np.inf), op=MPI.MAX)
+            size = float(np.linalg.norm(hi - lo))
+            out[b.tag] = fem.Constant(self.domain, default_scalar_type(
+                b.stabilise * b.material.E / size**2))
+        return out
 
     def external_work(self, ds: ufl.Measure, ids: Sequence[tuple[int, ...]]) -> ufl.Form | None:
         """Work of the tractions, int t . u dA over each traction's tagged facets.

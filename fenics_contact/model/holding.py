@@ -42,7 +42,7 @@ def problem_bodies(problem: ContactProblem) -> list[tuple[str, np.ndarray]]:
     tdim = problem.domain.topology.dim
     every = np.arange(problem.domain.topology.index_map(tdim).size_local, dtype=np.int32)
     return [(b.name, every if b.tag is None else solid.cell_tags.find(b.tag))
-            for b in solid.bodies]
+            for b in solid.bodies if b.stabilise <= 0.0]  # springs hold a stabilised body
 
 
 class ContactHold:

@@ -440,8 +440,8 @@ class ContactProblem(FrictionalContacts):
         nodes are gathered on the first call. Not checked ([]) with
         displacements of degree > 1 (the rigid modes are set at the vertices).
         """
-        if self.solid.degree != 1:
-            return []
+        if self.solid.degree != 1 or all(b.stabilise > 0.0 for b in self.solid.bodies):
+            return []  # weak springs hold a stabilised body
         if self._hold is None:
             from fenics_contact.model.holding import ContactHold
 
@@ -458,6 +458,11 @@ class ContactProblem(FrictionalContacts):
         from fenics_contact.model.passage import balls_passed_through
 
         return balls_passed_through(self.V, self.u, self.contacts)
+
+    def stabilisation_forces(self) -> dict[str, np.ndarray]:
+        """The force each stabilised body's springs put on it (collective; force)."""
+        return {b.name: self.solid.stabilisation_force(b.name) for b in self.solid.bodies
+                if b.stabilise > 0.0}
 
     def slot_uses(self) -> list:
         """Each 2D mortar pair's :class:`~.contacts.SlotUse` (collective)."""

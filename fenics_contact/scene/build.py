@@ -359,7 +359,8 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
                 f"the mesh; available: {named or ', '.join(map(str, present))}."
             )
         warn_locking(scene, spec.nu, f"[[body]] {spec.name!r}")
-        bodies.append(Body(spec.name, tag, material(spec.law, spec.E, spec.nu)))
+        bodies.append(Body(spec.name, tag, material(spec.law, spec.E, spec.nu),
+                           stabilise=spec.stabilise))
     prescribed, tractions = boundary_conditions(scene, body)
     contacts: list = []
     for pair in scene.pairs:

@@ -368,6 +368,7 @@ def check_bodies_held(
     """
     domain = problem.domain
     free = []
+    bodies = [b for b in bodies if b.stabilise <= 0.0]  # the springs hold the rest
     for body in bodies:
         marker = _body_cells(domain, cell_tags, body.tag)
         own = [(_facets_on(domain, marker, p.facets), p.at(1.0)) for p in prescribed]
@@ -395,7 +396,9 @@ def check_bodies_held(
         f"as a support, and a traction holds only the motions it presses into a contact). "
         f"Fix: prescribe components on a face of {name!r} (e.g. a support, a "
         "symmetry plane or a driven face: a prescribed displacement instead of a traction), "
-        "or start it touching the parts that hold it."
+        "or start it touching the parts that hold it; where nothing can (a round seal that "
+        "turns about its centre, held by friction only once pressed), tie it by weak "
+        f"springs: stabilise = 1e-6 in its [[body]] block (their force is reported)."
     )
 
 

@@ -200,6 +200,12 @@ KEY_DOCS: dict[str, dict[str, KeyDoc]] = {
                       default="required"),
         "E": KeyDoc("number > 0", "Young's modulus.", "F/L^2", "required"),
         "nu": KeyDoc("number in (-1, 0.5)", "Poisson's ratio.", default="required"),
+        "stabilise": KeyDoc("number in [0, 1e-3]", "Weak springs of stiffness stabilise E / "
+                            "L^2 per unit volume (L the body's box diagonal) tie the body to "
+                            "where it starts: they hold the rigid motions nothing holds before "
+                            "the load presses it (a round seal that only friction holds); "
+                            "their force is reported.", "", "0 (none)",
+                            field="BodySpec.stabilise"),
     },
     "pair": {
         "name": KeyDoc(_NAME, "The pair's name in messages and summary.json.",

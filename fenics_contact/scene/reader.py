@@ -13,7 +13,7 @@ KEYS: dict[str, set[str]] = {
     "": {"scene", "mesh", "material", "dirichlet", "traction", "obstacle", "contact", "solver",
          "output", "body", "pair", "pairing"},
     "pairing": {"automatic", "r", "relative", "mu", "tangential_r_max", "margin"},
-    "body": {"name", "tag", "law", "E", "nu"},
+    "body": {"name", "tag", "law", "E", "nu", "stabilise"},
     "pair": {"name", "striker", "target", "r", "relative", "mu", "tangential_r_max",
              "self_contact", "neighbourhood", "discretisation", "interference_until",
              "slots"},

@@ -168,7 +168,14 @@ def read_bodies(path: Path, data: dict[str, Any]) -> tuple[BodySpec, ...]:
             raise SceneError(f"{path.name}: [[body]] {name!r} needs 'tag', the cell tag of the "
                              "body (a number or a physical surface/volume name).")
         E, nu = elastic_constants(reader)
-        out.append(BodySpec(name=name, tag=reader.tag("tag"), law=law, E=E, nu=nu))
+        stabilise = reader.number("stabilise", 0.0)
+        if not 0.0 <= stabilise <= 1e-3:
+            raise reader.fail("stabilise", "is the stiffness of weak springs that tie the body "
+                              "to where it starts, relative to E / L^2: give a small number "
+                              "(1e-6 holds a body that only friction holds once pressed; at "
+                              "most 1e-3), or leave it out.")
+        out.append(BodySpec(name=name, tag=reader.tag("tag"), law=law, E=E, nu=nu,
+                            stabilise=stabilise))
     names = [b.name for b in out]
     if len(set(names)) != len(names):
         raise SceneError(f"{path.name}: [[body]] names {names} repeat; name each body once.")

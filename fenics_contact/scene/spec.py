@@ -69,6 +69,9 @@ class BodySpec:
     law: str
     E: float
     nu: float
+    #: Weak springs tying the body to its reference position: stiffness stabilise E / L^2
+    #: per unit volume (L the body's box diagonal); 0: none.
+    stabilise: float = 0.0
 
 
 @dataclass(frozen=True)
