@@ -44,7 +44,7 @@ class SlotUse(NamedTuple):
     the support out.
     """
 
-    contact: str
+    pair: str
     slots: int
     wanted: int
     now: int

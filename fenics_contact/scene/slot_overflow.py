@@ -35,7 +35,7 @@ def warn_slots_capped(problem: ContactProblem) -> None:
             kept = (f"at most {MOST_SLOTS} are chosen unasked (each costs compile time)"
                     if use.slots == MOST_SLOTS else f"the pair keeps {use.slots}")
             warnings.warn(SceneWarning(
-                f"mortar pair {use.contact!r}: where the surfaces meet, a striker node's two "
+                f"mortar pair {use.pair!r}: where the surfaces meet, a striker node's two "
                 f"facets overlap up to {use.wanted} target facets, and {kept}: "
                 f"{_fix(use.wanted)}."), stacklevel=2)
 
@@ -45,7 +45,7 @@ def slot_shortfall(problem: ContactProblem) -> str | None:
     short = [u for u in problem.slot_uses() if max(u.now, u.most) > u.slots]
     if not short:
         return None
-    return "; ".join(f"mortar pair {u.contact!r}: a striker node overlapped "
+    return "; ".join(f"mortar pair {u.pair!r}: a striker node overlapped "
                      f"{max(u.now, u.most)} target facets with {u.slots} slots "
                      f"({_fix(max(u.now, u.most) + 1)})" for u in short)
 
@@ -67,7 +67,7 @@ def warn_slot_overflow(problem: ContactProblem) -> None:
                     f"{use.most} target facets with {use.slots} slots (not in the last "
                     "state); its weighted gap left part of its support out there")
         warnings.warn(SceneWarning(
-            f"mortar pair {use.contact!r}: {what}. The target is finer there than the "
+            f"mortar pair {use.pair!r}: {what}. The target is finer there than the "
             f"slots allow: {_fix(most + 1)}."), stacklevel=2)
 
 
