@@ -244,6 +244,7 @@ class Solid:
             )
         #: each stabilised body's spring stiffness (stress per length^2), by tag
         self._spring = self._springs(cell_tags)
+        self._spring_forms: dict = {}
         self._internal_form: fem.Form | None = None
         # det F at the energy's degree-2 points: every load step checks it (compiled with
         # the other forms, not inside the first step)
@@ -272,9 +273,12 @@ class Solid:
         b = next(b for b in self.bodies if b.name == body)
         if b.tag not in self._spring:
             return np.zeros(self.gdim)
-        k = self._spring[b.tag]
-        return np.array([self.comm.allreduce(fem.assemble_scalar(fem.form(
-            -k * self.u[i] * self._dx[b.tag])), op=MPI.SUM) for i in range(self.gdim)])
+        if b.tag not in self._spring_forms:  # compiled once, assembled at every step
+            k = self._spring[b.tag]
+            self._spring_forms[b.tag] = [fem.form(-k * self.u[i] * self._dx[b.tag])
+                                         for i in range(self.gdim)]
+        return np.array([self.comm.allreduce(fem.assemble_scalar(f), op=MPI.SUM)
+                         for f in self._spring_forms[b.tag]])
 
     def _springs(self, cell_tags: mesh.MeshTags | None) -> dict:
         """Each stabilised body's spring stiffness stabilise E / L^2 (a Constant, by tag)."""
