@@ -2,6 +2,9 @@
 // origin) above a block [-1, L - 1] x [-D, 0] (scenes/ironing.toml,
 // scenes/ironing_friction.toml, benchmarks/cases.py: ironing).
 //
+// The arc is meshed at h_indenter at the tip and arc_grading * h_indenter at its
+// ends (x = +-R).
+//
 // Physical groups:
 //   Surface "striker" = 1 (indenter), Surface "target" = 2 (block)    (cell tags)
 //   Curve "top" = 2, "striker_arc" = 3, "target_face" = 4, "bottom" = 5  (facet tags)
@@ -11,12 +14,13 @@ DefineConstant[
   L = {4.0, Name "Parameters/length"},
   D = {1.0, Name "Parameters/depth"},
   h_indenter = {0.04, Name "Parameters/h_indenter"},
-  h_block = {0.06, Name "Parameters/h_block"}
+  h_block = {0.06, Name "Parameters/h_block"},
+  arc_grading = {4, Name "Parameters/arc_grading"}
 ];
 Geometry.AutoCoherence = 0;  // keep the two bodies apart
 
-Point(1) = {0, R, 0, 4 * h_indenter}; Point(2) = {-R, R, 0, 4 * h_indenter};
-Point(3) = {0, 0, 0, h_indenter}; Point(4) = {R, R, 0, 4 * h_indenter};
+Point(1) = {0, R, 0, arc_grading * h_indenter}; Point(2) = {-R, R, 0, arc_grading * h_indenter};
+Point(3) = {0, 0, 0, h_indenter}; Point(4) = {R, R, 0, arc_grading * h_indenter};
 Circle(1) = {2, 1, 3}; Circle(2) = {3, 1, 4}; Line(3) = {4, 2};
 Curve Loop(1) = {1, 2, 3}; Plane Surface(1) = {1};
 

@@ -797,3 +797,45 @@ def test_load_steps_that_pass_over_a_knot_of_a_frictional_path_are_warned(tmp_pa
     with warnings.catch_warnings():
         warnings.simplefilter("error", SceneWarning)
         _build(write(tmp_path, scene))
+
+
+def test_cells_that_belong_to_no_body_are_named_before_the_solve(tmp_path):
+    """A [[body]] scene on a mesh holding a second body that no [[body]] declares (the
+    ironing mesh's indenter, to be replaced by a rigid ball) failed at the first linear
+    solve with a singular Jacobian and advice about contact conditions."""
+    from fenics_contact.scene.build import build_problem
+
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "scenes" / "ironing.toml").read_text().replace(
+        '"../meshes/', f'"{root / "meshes"}/')
+    text = re.sub(r'^\[\[body\]\]\nname = "indenter".*?\n\n', "", text, flags=re.S | re.M)
+    text = re.sub(r"^\[\[pair\]\]\n.*?\n\n", "[[obstacle]]\ntype = \"ball\"\n"
+                  "centre = [0.0, 0.5]\nradius = 0.5\ntag = \"target_face\"\n\n", text,
+                  flags=re.S | re.M)
+    path = tmp_path / "block_alone.toml"
+    path.write_text(text)
+    scene = load_scene(path)
+    assert [b.name for b in scene.bodies] == ["block"]
+    with pytest.raises(SceneError, match=r"block_alone.toml: the mesh's \d+ cells tagged 1 "
+                       r"\('striker'\) belong to no \[\[body\]\] \(declared: 'block' \(tag 2\)\)"
+                       r".*Add a \[\[body\]\] with their tag"):
+        build_problem(scene)
+
+
+def test_a_solid_refuses_cells_of_no_body():
+    """The library's Solid says the same (tag numbers, as it knows no names)."""
+    from mpi4py import MPI
+
+    from dolfinx import mesh as dmesh
+
+    from fenics_contact.model.materials import material
+    from fenics_contact.model.problem import Body, Solid
+
+    domain = dmesh.create_unit_square(MPI.COMM_WORLD, 4, 4)
+    cells = np.arange(domain.topology.index_map(2).size_local, dtype=np.int32)
+    midpoints = domain.geometry.x[domain.geometry.dofmaps[0][cells]].mean(axis=1)
+    tags = dmesh.meshtags(domain, 2, cells, np.where(midpoints[:, 0] < 0.5, 1, 2).astype(np.int32))
+    law = material("linear", 100.0, 0.3)
+    with pytest.raises(ValueError, match=r"The mesh's 16 cells tagged 2 belong to no body"):
+        Solid(domain, [Body("left", 1, law)], cell_tags=tags)
+    Solid(domain, [Body("left", 1, law), Body("right", 2, law)], cell_tags=tags)

@@ -185,9 +185,11 @@ def main() -> None:
                         help="facet size at the indenter's tip (shipped 0.04)")
     parser.add_argument("--h-block", type=float, default=None,
                         help="facet size along the block's face (shipped 0.06)")
+    parser.add_argument("--arc-grading", type=float, default=None,
+                        help="facet size at the arc's ends over the tip's (shipped 4)")
     args = parser.parse_args()
-    sizes = {k: v for k, v in (("h_indenter", args.h_indenter), ("h_block", args.h_block))
-             if v is not None}
+    sizes = {k: v for k, v in (("h_indenter", args.h_indenter), ("h_block", args.h_block),
+                               ("arc_grading", args.arc_grading)) if v is not None}
     mesh = "coarse" if args.coarse else ("shipped" if not sizes else ", ".join(
         f"{k} = {v:g}" for k, v in sizes.items()))
     record: dict = {"machine": harness.machine(), "mesh": mesh,

@@ -173,6 +173,47 @@ def _check_bodies(domain: mesh.Mesh, cell_tags: mesh.MeshTags | None,
                 f"Body {b.name!r} has cell tag {b.tag}, which no cell of the mesh carries "
                 f"(tags present: {sorted(present)})."
             )
+    unclaimed = unclaimed_cells(domain, cell_tags, tags)
+    if unclaimed:
+        text = describe_unclaimed(unclaimed)
+        raise ValueError(
+            f"{text[0].upper()}{text[1:]} belong to no body: their displacements would be "
+            "unknowns without stiffness (a singular Jacobian). Give them a body, or mesh "
+            "without them."
+        )
+
+
+def unclaimed_cells(domain: mesh.Mesh, cell_tags: mesh.MeshTags,
+                    tags: Sequence[int | None]) -> dict[int | None, int]:
+    """Cells no body's tag holds, counted per tag (None: cells without a tag; collective)."""
+    owned = domain.topology.index_map(domain.topology.dim).size_local
+    keep = cell_tags.indices < owned
+    indices, values = cell_tags.indices[keep], cell_tags.values[keep]
+    counts: dict[int | None, int] = {}
+    untagged = owned - np.unique(indices).size
+    if untagged:
+        counts[None] = int(untagged)
+    for tag in np.unique(values).tolist():
+        if tag not in tags:
+            counts[int(tag)] = int(np.sum(values == tag))
+    merged: dict[int | None, int] = {}
+    for part in domain.comm.allgather(counts):
+        for tag, n in part.items():
+            merged[tag] = merged.get(tag, 0) + n
+    return merged
+
+
+def describe_unclaimed(counts: dict[int | None, int], names: dict[int, str] | None = None) -> str:
+    """'The 312 cells tagged 1 ("striker")'-style words for :func:`unclaimed_cells`."""
+    names = names or {}
+    parts = []
+    for tag, n in sorted(counts.items(), key=lambda kv: (kv[0] is None, kv[0] or 0)):
+        if tag is None:
+            parts.append(f"{n} cells without a cell tag")
+        else:
+            name = f" ({names[tag]!r})" if tag in names else ""
+            parts.append(f"{n} cells tagged {tag}{name}")
+    return "the mesh's " + " and ".join(parts)
 
 
 class Solid:

@@ -18,6 +18,7 @@ from dolfinx import mesh
 
 from mpi4py import MPI
 
+from fenics_contact.model.body import describe_unclaimed, unclaimed_cells
 from fenics_contact.model.contact import ContactSettings
 from fenics_contact.model.friction import FrictionSettings
 from fenics_contact.model.materials import material
@@ -361,6 +362,16 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
         warn_locking(scene, spec.nu, f"[[body]] {spec.name!r}")
         bodies.append(Body(spec.name, tag, material(spec.law, spec.E, spec.nu),
                            stabilise=spec.stabilise))
+    unclaimed = unclaimed_cells(body.domain, body.cell_tags, [b.tag for b in bodies])
+    if unclaimed:
+        names = {t: n for n, t in body.cell_names.items()}
+        declared = ", ".join(f"{b.name!r} (tag {b.tag})" for b in bodies)
+        raise SceneError(
+            f"{scene.path.name}: {describe_unclaimed(unclaimed, names)} belong to no "
+            f"[[body]] (declared: {declared}); nothing would hold or stiffen them. Add a "
+            "[[body]] with their tag, or mesh without them (a .geo that leaves that part "
+            "out)."
+        )
     prescribed, tractions = boundary_conditions(scene, body)
     contacts: list = []
     for pair in scene.pairs:
