@@ -824,9 +824,9 @@ def test_cells_that_belong_to_no_body_are_named_before_the_solve(tmp_path):
 
 def test_a_solid_refuses_cells_of_no_body():
     """The library's Solid says the same (tag numbers, as it knows no names)."""
-    from mpi4py import MPI
-
     from dolfinx import mesh as dmesh
+
+    from mpi4py import MPI
 
     from fenics_contact.model.materials import material
     from fenics_contact.model.problem import Body, Solid
