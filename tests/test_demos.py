@@ -168,7 +168,7 @@ def test_two_cylinders_demo_follows_hertz_with_both_pairs(tmp_path, monkeypatch)
     assert summary["mpi_ranks"] == MPI.COMM_WORLD.size
     nts, mortar = summary["runs"]["node-to-segment"], summary["runs"]["mortar"]
     for run in (nts, mortar):
-        assert run["h_contact"] == 0.01
+        assert run["h_contact"] == 0.005
         assert len(run["iterations_per_step"]) == 10 and max(run["iterations_per_step"]) <= 6
         assert abs(run["p0_error"]) < 0.01  # the fitted peak against Hertz
         kkt = run["signorini"]

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import sys
 from dataclasses import replace
 from pathlib import Path
@@ -102,12 +103,66 @@ def run(discretisation: str, coarse: bool, surface_tol: float, swap: bool = Fals
         })
 
     path = solve_load_path(strategy, scene.solver.steps, max_cutbacks=4, on_step=on_step)
+    return _summary(discretisation, path, rows, surface_tol)
+
+
+def _rigid_scene(quadrature: str, sizes: dict[str, float] | None, folder: Path) -> Path:
+    """The shipped scene with the indenter replaced by a rigid circle on the same path."""
+    text = SCENE.read_text().replace('"../meshes/', f'"{ROOT / "meshes"}/')
+    knots = next(d for d in load_scene(SCENE).dirichlet if d.path).path
+    ball = (f'[[obstacle]]\nname = "rigid_circle"\ntype = "ball"\ncentre = [0.0, {RADIUS}]\n'
+            f"radius = {RADIUS}\nschedule = {[list(k) for k in knots]}\n"
+            f'tag = "target_face"\nr = 1.0\nrelative = true\nquadrature = "{quadrature}"\n\n')
+    text = re.sub(r'^\[\[body\]\]\nname = "indenter".*?\n\n', "", text, flags=re.S | re.M)
+    text = re.sub(r"^\[\[pair\]\]\n.*?\n\n", ball, text, flags=re.S | re.M)
+    text = re.sub(r'^\[\[dirichlet\]\]\ntag = "top".*?\n\n', "", text, flags=re.S | re.M)
+    params = {"h_indenter": 0.04, "h_block": 0.06, **(sizes or {}), "indenter": 0}
+    text = re.sub(r"^parameters = .*$", "parameters = { " + ", ".join(
+        f"{k} = {v:g}" for k, v in params.items()) + " }", text, flags=re.M)
+    path = folder / f"ironing_rigid_{quadrature}.toml"
+    path.write_text(text)
+    return path
+
+
+def run_rigid(quadrature: str, sizes: dict[str, float] | None, steps: int | None,
+              folder: Path) -> dict:
+    """The floor of the block's own discretisation: an exact rigid circle on the same path.
+
+    Nodal contact on the block's face (``quadrature = "nodal"``) or at its Gauss
+    points; R_x of the circle = minus the block's support reaction.
+    """
+    scene = load_scene(_rigid_scene(quadrature, sizes, folder))
+    if steps is not None:
+        scene = replace(scene, solver=replace(scene.solver, steps=steps))
+    body = build_mesh(scene, MPI.COMM_WORLD)
+    problem = build_two_body_problem(scene, body)
+    bottom = tagged_facets(body, scene, "bottom", "bottom")
+    knots = np.asarray(scene.obstacles[0].obstacle.schedule)
+    strategy = Extrapolated(make_strategy("gnrm", problem, SolverSettings(atol=scene.solver.atol)))
+    rows: list[dict] = []
+
+    def on_step(step) -> None:
+        force = -problem.reaction(bottom)
+        rows.append({"step": step.step, "load_factor": step.load_factor,
+                     "slide_over_R": float(np.interp(step.load_factor, knots[:, 0],
+                                                     knots[:, 1])) / RADIUS,
+                     "reaction_x": float(force[0]), "reaction_y": float(force[1]),
+                     "iterations": step.iterations, "cutbacks": step.cutbacks,
+                     "order": order(step.residuals[-1]),
+                     "surface_depth": step.max_penetration})
+
+    path = solve_load_path(strategy, scene.solver.steps, max_cutbacks=4, on_step=on_step)
+    return _summary(f"rigid circle, {quadrature}", path, rows, np.nan)
+
+
+def _summary(name: str, path, rows: list[dict], surface_tol: float) -> dict:
+    """The steady window's R_x figures and the run's counts."""
     steady = [r for r in rows if WINDOW[0] <= r["slide_over_R"] <= WINDOW[1] + 1e-9]
     rx = np.array([r["reaction_x"] for r in steady])
     ry = np.array([r["reaction_y"] for r in steady])
     orders = np.array([r["order"] for r in rows])
     return {
-        "discretisation": discretisation, "status": path.status, "steps": len(rows),
+        "discretisation": name, "status": path.status, "steps": len(rows),
         "iterations": int(sum(r["iterations"] for r in rows)),
         "surface_tol": surface_tol,
         "steady_steps": len(steady),
@@ -134,8 +189,8 @@ def report(record: dict) -> list[str]:
         "| mean -R_y | median order | largest surface depth |",
         "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
-    for d in DISCRETISATIONS:
-        r = record[d]
+    for d in DISCRETISATIONS + tuple(record.get("rigid", {})):
+        r = record[d] if d in record else record["rigid"][d]
         lines.append(
             f"| {d} | {r['status']} | {r['steps']} | {r['cutbacks']} | {r['iterations']} | "
             f"{r['rx_amplitude']:.4f} | "
@@ -144,6 +199,10 @@ def report(record: dict) -> list[str]:
     lines += ["", f"Amplitude ratio mortar / node-to-segment: {record['amplitude_ratio']:.3f}; "
               f"RMS ratio {record['rms_ratio']:.3f}. Node-to-segment ran with surface_tol = "
               f"{record['node-to-segment']['surface_tol']:g} h."]
+    if record.get("rigid"):
+        lines += ["", "Rigid circle rows: the indenter replaced by an exact rigid circle on the "
+                  "same path over the same block mesh (`--rigid`): the R_x that the block's own "
+                  "discretisation leaves, with no polygon on the indenter's side."]
     return lines
 
 
@@ -185,6 +244,9 @@ def main() -> None:
                         help="facet size at the indenter's tip (shipped 0.04)")
     parser.add_argument("--h-block", type=float, default=None,
                         help="facet size along the block's face (shipped 0.06)")
+    parser.add_argument("--rigid", action="store_true",
+                        help="also an exact rigid circle on the same path (nodal and Gauss "
+                             "contact on the block): the block's own floor")
     parser.add_argument("--arc-grading", type=float, default=None,
                         help="facet size at the arc's ends over the tip's (shipped 4)")
     args = parser.parse_args()
@@ -198,6 +260,10 @@ def main() -> None:
                                     args.swap, args.steps, sizes)
     record["mortar"] = run("mortar", args.coarse, SolverSettings().surface_tol, args.swap,
                            args.steps, sizes)
+    if args.rigid:
+        args.out.mkdir(parents=True, exist_ok=True)
+        record["rigid"] = {f"rigid circle, {q}": run_rigid(q, sizes, args.steps, args.out)
+                           for q in ("nodal", "gauss")}
     nts, mortar = record["node-to-segment"], record["mortar"]
     record["amplitude_ratio"] = mortar["rx_amplitude"] / nts["rx_amplitude"]
     record["rms_ratio"] = mortar["rx_rms"] / nts["rx_rms"]

@@ -28,6 +28,10 @@ def ironing_mortar_table(data: dict) -> Rows:
             for d in PAIRS for r in [data[d]]]
     rows.append(["mortar / node-to-segment", "", "", data["amplitude_ratio"], data["rms_ratio"],
                  "", "", "", ""])
+    # the indenter replaced by an exact rigid circle over the same block mesh (--rigid)
+    rows += [[name, r["status"], r["iterations"], r["rx_amplitude"], r["rx_rms"], r["rx_mean"],
+              -r["ry_mean"], r["median_order"], r["max_surface_depth"]]
+             for name, r in data.get("rigid", {}).items()]
     return header, rows
 
 

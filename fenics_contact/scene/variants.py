@@ -37,3 +37,9 @@ def with_contact_settings(
 def with_solver(scene: Scene, **settings: Any) -> Scene:
     """The scene with some [solver] keys changed (method, steps, rtol, predictor, ...)."""
     return replace(scene, solver=replace(scene.solver, **settings))
+
+
+def with_mesh_parameters(scene: Scene, **parameters: float) -> Scene:
+    """The scene with some [mesh] parameters of its .geo changed (h_contact, ...)."""
+    merged = {**scene.mesh.parameters, **parameters}
+    return replace(scene, mesh=replace(scene.mesh, parameters=merged))
