@@ -839,3 +839,22 @@ def test_a_solid_refuses_cells_of_no_body():
     with pytest.raises(ValueError, match=r"The mesh's 16 cells tagged 2 belong to no body"):
         Solid(domain, [Body("left", 1, law)], cell_tags=tags)
     Solid(domain, [Body("left", 1, law), Body("right", 2, law)], cell_tags=tags)
+
+
+def test_a_pair_whose_target_is_the_far_side_of_its_body_is_named(tmp_path):
+    """The target given as the far face of the right body (both outward normals down) read
+    as bodies "0.4 inside each other", or, with nothing else holding a body, as a free
+    translation. It is now refused as surfaces that nowhere face each other, with the
+    target body's surface that does face the striker."""
+    from fenics_contact.scene.build import build_problem
+
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "scenes" / "stack_3_blocks.toml").read_text().replace(
+        '"../meshes/', f'"{root / "meshes"}/')
+    path = tmp_path / "far_side.toml"
+    path.write_text(text.replace('target = "bottom_topside"', 'target = "floor_face"'))
+    with pytest.raises(SceneError, match=r"far_side.toml: \[\[pair\]\] 'middle-on-bottom': "
+                       r"striker = 'middle_underside' and target = 'floor_face' nowhere face "
+                       r"each other.*the surface of that body that faces it is "
+                       r"'bottom_topside'\."):
+        build_problem(load_scene(path))

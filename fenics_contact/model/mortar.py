@@ -39,6 +39,7 @@ from mpi4py import MPI
 
 from fenics_contact.model.contact import ContactSettings, ContactSurface, assemble_local
 from fenics_contact.model.contacts import Contact, SlotUse
+from fenics_contact.model.form_batches import CONTACT_CFLAGS
 from fenics_contact.model.friction import FrictionSettings
 from fenics_contact.model.search import penetration_depth
 from fenics_contact.model.segments import (
@@ -327,7 +328,7 @@ class MortarContact(Contact):
 
     #: The kernels are large (MBs of C): cheap C optimisation compiles them in a
     #: fraction of the time at a small cost in assembly (docs/two_bodies.md).
-    jit_options: ClassVar[dict] = {"cffi_extra_compile_args": ["-O1", "-g0"]}
+    jit_options: ClassVar[dict] = {"cffi_extra_compile_args": CONTACT_CFLAGS}
 
     def __init__(self, striker_facets: np.ndarray, target_facets: np.ndarray,
                  settings: ContactSettings, *, striker: str | None = None,

@@ -35,6 +35,7 @@ from mpi4py import MPI
 from fenics_contact.model.body import Body
 from fenics_contact.model.contact import ContactSettings, ContactSurface
 from fenics_contact.model.contacts import Contact
+from fenics_contact.model.form_batches import CONTACT_CFLAGS
 from fenics_contact.model.friction import FrictionSettings, symmetric_frame
 from fenics_contact.model.search import (
     TIE_TOL,
@@ -595,7 +596,7 @@ class NodeToSegmentContact(Contact):
     #: compiles the kernel's blocks in 5.9 s against 9.4 s at -O2 (frictional
     #: hemispheres) and assembles as fast; it costs the bodies' own (small)
     #: kernels about a tenth of their assembly speed (docs/benchmarks.md).
-    jit_options: ClassVar[dict] = {"cffi_extra_compile_args": ["-O1", "-g0"]}
+    jit_options: ClassVar[dict] = {"cffi_extra_compile_args": CONTACT_CFLAGS}
 
     def __init__(
         self,

@@ -41,6 +41,7 @@ from dolfinx.fem import petsc as fem_petsc
 
 from mpi4py import MPI
 
+from fenics_contact.model.form_batches import CONTACT_CFLAGS
 from fenics_contact.model.segments3d import REFERENCE, STRIKER_EDGES, Segments
 
 #: Columns of a corner's provenance row: kind (3), striker corner (3), target
@@ -131,8 +132,8 @@ class SegmentForms:
         if self._compiled is None:
             self._compiled = {
                 name: fem.form(getattr(self, f"{name}_form"), jit_options={
-                    "cffi_extra_compile_args": [HESSIAN_OPT if name == "hessian" else "-O1",
-                                                "-g0"]})
+                    "cffi_extra_compile_args": [HESSIAN_OPT, "-g0"] if name == "hessian"
+                    else CONTACT_CFLAGS})
                 for name in ("gap", "weight", "gap_tangent", "weight_tangent", "hessian")
             }
         return self._compiled

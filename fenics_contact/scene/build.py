@@ -42,6 +42,7 @@ from fenics_contact.scene.checks import (
     check_initial_overlap,
     check_obstacles_face_their_facets,
     check_pair_surfaces,
+    check_pair_surfaces_face,
     facet_owners,
     held_by_closed_contacts,
     warn_locking,
@@ -61,6 +62,7 @@ from fenics_contact.scene.schema import (
     ContactSpec,
     ObstacleContactSpec,
     ObstacleSpec,
+    PairSpec,
     Scene,
     SceneError,
 )
@@ -378,6 +380,10 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
         striker = tagged_facets(body, scene, f"[[pair]] {pair.name!r} striker", pair.striker)
         target = tagged_facets(body, scene, f"[[pair]] {pair.name!r} target", pair.target)
         check_pair_surfaces(scene, body.domain, body.cell_tags, bodies, striker, target, pair)
+        if not pair.self_contact:
+            check_pair_surfaces_face(scene, body.domain, striker, target, pair,
+                                     lambda pair=pair, target=target: _surfaces_beside(
+                                         scene, body, bodies, pair, target))
         friction = (None if pair.mu is None
                     else FrictionSettings(pair.mu, pair.tangential_r_max))
         settings = ContactSettings(r=pair.r, relative=pair.relative,
@@ -404,6 +410,20 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
     check_initial_overlap(scene, problem)
     warn_initial_penetration(scene, problem)
     return problem
+
+
+def _surfaces_beside(scene: Scene, body: BodyMesh, bodies: list[Body], pair: PairSpec,
+                     target: np.ndarray) -> dict[str, np.ndarray]:
+    """The other named facet groups of the pair's target body (collective)."""
+    owner = facet_owners(body.domain, body.cell_tags, bodies, target)
+    found = {}
+    for name in sorted(body.names):
+        if name in (pair.striker, pair.target):
+            continue
+        facets = body.facet_tags.find(body.names[name])
+        if facet_owners(body.domain, body.cell_tags, bodies, facets) == owner:
+            found[name] = facets
+    return found
 
 
 def _problem(scene: Scene, solid: Solid, contacts: list) -> ContactProblem:

@@ -9,7 +9,7 @@ that start deeply inside each other.
 from __future__ import annotations
 
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -40,7 +40,7 @@ _VERTICES = {"interval": 2, "triangle": 3, "quadrilateral": 4, "tetrahedron": 4,
 
 
 def _where(point: np.ndarray, gdim: int) -> str:
-    return "(" + ", ".join(f"{c:.4g}" for c in point[:gdim]) + ")"
+    return "(" + ", ".join(f"{c + 0.0:.4g}" for c in point[:gdim]) + ")"
 
 
 def _first_on_any_rank(
@@ -171,6 +171,62 @@ def check_pair_surfaces(
             "bodies: give the target surface of the other body (or self_contact = true for "
             "self-contact)."
         )
+
+
+def _gathered_normals(domain: mesh.Mesh, facets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Outward normals and centres of facets, from every rank (reference configuration)."""
+    normal, centre = outward_facet_normals(domain, facets)
+    return tuple(np.concatenate(domain.comm.allgather(a)) for a in (normal, centre))
+
+
+def _nearest_alignment(striker: tuple[np.ndarray, np.ndarray],
+                       target: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+    """n_s . n_t of each striker facet with the target facet nearest to it (-1: facing)."""
+    from scipy.spatial import cKDTree
+
+    (ns, cs), (nt, ct) = striker, target
+    _, nearest = cKDTree(ct).query(cs)
+    return np.einsum("ij,ij->i", ns, nt[nearest])
+
+
+def check_pair_surfaces_face(
+    scene: Scene,
+    domain: mesh.Mesh,
+    striker: np.ndarray,
+    target: np.ndarray,
+    pair: PairSpec,
+    alternatives: Callable[[], dict[str, np.ndarray]],
+) -> None:
+    """Refuse a pair whose surfaces nowhere face each other.
+
+    A striker can only touch target facets whose outward normals oppose its
+    own. When the target facet nearest to every striker facet has its
+    outward normal along the striker's (n_s . n_t > 1/2 everywhere), the
+    target names a face of the right body turned the wrong way (its far
+    side): the projection then reads the bodies as deeply inside each
+    other, or the pair never closes and the body is reported free.
+    ``alternatives``: the other named surfaces of the target's body (called
+    on refusal only; collective), offered when one of them faces the striker.
+    """
+    s = _gathered_normals(domain, striker)
+    t = _gathered_normals(domain, target)
+    if s[0].shape[0] == 0 or t[0].shape[0] == 0:
+        return
+    alignment = _nearest_alignment(s, t)
+    if alignment.min() <= 0.5:
+        return
+    facing_names = [name for name, facets in alternatives().items()
+                    if _nearest_alignment(s, _gathered_normals(domain, facets)).min() < -0.5]
+    fix = (f"the surface of that body that faces it is {' or '.join(map(repr, facing_names))}"
+           if facing_names else "give the target surface of the other body that faces it")
+    gdim = domain.geometry.dim
+    raise SceneError(
+        f"{scene.path.name}: [[pair]] {pair.name!r}: striker = {pair.striker!r} and target = "
+        f"{pair.target!r} nowhere face each other: the target's facets nearest to the "
+        f"striker have outward normals along the striker's (e.g. {_where(t[0][0], gdim)} and "
+        f"{_where(s[0][0], gdim)} near {_where(s[1][0], gdim)}), so they could never touch; "
+        f"the target is probably the far side of its body: {fix}."
+    )
 
 
 def warn_skipped_knots(scene: Scene) -> list[float]:
