@@ -300,26 +300,21 @@ STABILISATION_SHARE = 1e-3
 def warn_stabilisation(scene: Scene, problem: ContactProblem, path: RunRecord) -> None:
     """Warn where a stabilised body's springs carry a share of the load (collective).
 
-    The load: the largest support reaction or contact force of the last step.
+    The load: the largest traction resultant, support reaction or contact
+    force of the state the run ended in (:func:`~fenics_contact.model.springs.load_scale`).
     """
+    from fenics_contact.model.springs import spring_loads
     from fenics_contact.scene.checks import SceneWarning
 
-    forces = problem.stabilisation_forces()
-    if not forces or not path.steps:
+    if not path.steps:
         return
-    last = path.steps[-1]
-    scale = max([abs(last.contact_force)] + [
-        float(np.linalg.norm(v)) for k, v in (last.reactions or {}).items()
-        if not k.startswith("stabilise ")] + [
-        abs(c.get("normal_force", 0.0)) for c in (last.contacts or {}).values()])
-    for name, force in forces.items():
-        size = float(np.linalg.norm(force))
-        if size > STABILISATION_SHARE * scale:
+    for s in spring_loads(problem):
+        if s.share > STABILISATION_SHARE:
             warnings.warn(SceneWarning(
-                f"{scene.path.name}: [[body]] {name!r}: its stabilising springs carry "
-                f"{size:.3g}, {size / max(scale, 1e-300):.2%} of the largest force of the last "
-                "step: they hold more than rigid motions; lower stabilise, or hold the body "
-                "by a support."), stacklevel=2)
+                f"{scene.path.name}: [[body]] {s.body!r}: its stabilising springs carry "
+                f"{s.force:.3g}, {s.share:.2%} of the load of the last step (the largest "
+                "traction resultant, support reaction or contact force): they hold more than "
+                "rigid motions; lower stabilise, or hold the body by a support."), stacklevel=2)
 
 
 def _warn_loose_tolerance(scene: Scene, problem: ContactProblem) -> None:

@@ -94,7 +94,8 @@ def test_inverted_step_is_cut_back_then_refused_with_its_place():
 
 def test_statuses_are_documented():
     assert set(STATUSES) == {
-        "converged", "cycling", "diverged", "max_iterations", "inverted", "error"
+        "converged", "cycling", "diverged", "max_iterations", "inverted", "held_by_springs",
+        "error",
     }
 
 

@@ -146,7 +146,9 @@ def _solve(
             advice = _advice(scene, failed.status,
                              getattr(outcome.problem, "initial_overlap", None),
                              failed.message or "", slots)
-            print(f"fenics-contact: load step {failed.step} of {steps} did not converge "
+            verdict = ("was refused" if failed.status == "held_by_springs"
+                       else "did not converge")
+            print(f"fenics-contact: load step {failed.step} of {steps} {verdict} "
                   f"({failed.message or failed.status}); {_kept(failed.step - 1, out)}"
                   f"{advice}", file=sys.stderr)
         return 1

@@ -113,6 +113,24 @@ class SurfaceTraction:
     value: tuple[float, ...]
 
 
+def facet_area(domain: mesh.Mesh, facets: np.ndarray) -> float:
+    """The reference area of the facets, summed over ranks (length in 2D, area in 3D).
+
+    Straight facets: segments, triangles, or quadrilaterals (half the cross
+    product of their diagonals, in dolfinx's vertex order 0-1-3-2).
+    """
+    fdim = domain.topology.dim - 1
+    owned = facets[facets < domain.topology.index_map(fdim).size_local]
+    x = domain.geometry.x[mesh.entities_to_geometry(domain, fdim, owned)]
+    if fdim == 1:
+        local = np.linalg.norm(x[:, 1] - x[:, 0], axis=1).sum()
+    elif x.shape[1] == 3:
+        local = 0.5 * np.linalg.norm(np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]), axis=1).sum()
+    else:
+        local = 0.5 * np.linalg.norm(np.cross(x[:, 3] - x[:, 0], x[:, 2] - x[:, 1]), axis=1).sum()
+    return domain.comm.allreduce(float(local), op=MPI.SUM)
+
+
 @dataclass(frozen=True)
 class DetFMinimum:
     """Smallest det F = det(I + grad u) over the body's quadrature points.
@@ -323,21 +341,47 @@ class Solid:
 
     def _springs(self, cell_tags: mesh.MeshTags | None) -> dict:
         """Each stabilised body's spring stiffness stabilise E / L^2 (a Constant, by tag)."""
-        out = {}
+        return {b.tag: fem.Constant(self.domain, default_scalar_type(
+                    b.stabilise * b.material.E / self.body_size(b.name)**2))
+                for b in self.bodies if b.stabilise > 0.0}
+
+    def _body_cells(self, body: Body) -> np.ndarray:
+        """The owned cells of ``body`` (every owned cell for an untagged body)."""
         tdim = self.domain.topology.dim
-        for b in self.bodies:
-            if b.stabilise <= 0.0:
-                continue
-            cells = (np.arange(self.domain.topology.index_map(tdim).size_local, dtype=np.int32)
-                     if b.tag is None else cell_tags.find(b.tag))
-            nodes = np.unique(self.domain.geometry.dofmaps[0][cells].reshape(-1))
-            x = self.domain.geometry.x[nodes, : self.gdim]
-            lo = self.comm.allreduce(np.min(x, axis=0, initial=np.inf), op=MPI.MIN)
-            hi = self.comm.allreduce(np.max(x, axis=0, initial=-np.inf), op=MPI.MAX)
-            size = float(np.linalg.norm(hi - lo))
-            out[b.tag] = fem.Constant(self.domain, default_scalar_type(
-                b.stabilise * b.material.E / size**2))
-        return out
+        if body.tag is None:
+            return np.arange(self.domain.topology.index_map(tdim).size_local, dtype=np.int32)
+        return self.cell_tags.find(body.tag)
+
+    def _body(self, name: str) -> Body:
+        return next(b for b in self.bodies if b.name == name)
+
+    def body_size(self, body: str) -> float:
+        """The diagonal of the body's reference bounding box (length; collective)."""
+        cells = self._body_cells(self._body(body))
+        nodes = np.unique(self.domain.geometry.dofmaps[0][cells].reshape(-1))
+        x = self.domain.geometry.x[nodes, : self.gdim]
+        lo = self.comm.allreduce(np.min(x, axis=0, initial=np.inf), op=MPI.MIN)
+        hi = self.comm.allreduce(np.max(x, axis=0, initial=-np.inf), op=MPI.MAX)
+        return float(np.linalg.norm(hi - lo))
+
+    def body_motion(self, body: str) -> float:
+        """The largest nodal displacement |u| over the body's cells (length; collective)."""
+        cells = self._body_cells(self._body(body))
+        dofs = np.unique(self.V.dofmap.list[cells].reshape(-1))
+        u = self.u.x.array.reshape(-1, self.gdim)[dofs]
+        local = float(np.max(np.linalg.norm(u, axis=1), initial=0.0))
+        return self.comm.allreduce(local, op=MPI.MAX)
+
+    def traction_resultants(self) -> list[np.ndarray]:
+        """Each traction's resultant at the current load: value times reference area (force).
+
+        Per unit thickness in 2D; collective. The areas are measured once.
+        """
+        if not hasattr(self, "_traction_areas"):
+            self._traction_areas = [facet_area(self.domain, t.facets) for t in self.tractions]
+        return [np.array(const.value, float) * area
+                for (const, _), area in zip(self._traction_constants, self._traction_areas,
+                                            strict=True)]
 
     def external_work(self, ds: ufl.Measure, ids: Sequence[tuple[int, ...]]) -> ufl.Form | None:
         """Work of the tractions, int t . u dA over each traction's tagged facets.

@@ -55,7 +55,9 @@ class Status(StrEnum):
     (or stick/slip pattern) repeats without the residual falling; ``diverged``:
     the residual grew beyond recovery or is not finite; ``max_iterations``: the
     iteration limit was reached; ``inverted``: converged with elements turned
-    inside out (det F <= 0); ``error``: an exception (a run record's message says
+    inside out (det F <= 0); ``held_by_springs``: converged with the weak springs
+    of a stabilised body holding more than 1e-2 of the load (the contact that
+    should hold it carries nothing); ``error``: an exception (a run record's message says
     which).
     """
 
@@ -64,6 +66,7 @@ class Status(StrEnum):
     DIVERGED = "diverged"
     MAX_ITERATIONS = "max_iterations"
     INVERTED = "inverted"
+    HELD_BY_SPRINGS = "held_by_springs"
     ERROR = "error"
 
 

@@ -15,6 +15,9 @@ A converged solve is accepted only when det F > 0 at every quadrature point
 of the body (:meth:`ContactProblem.min_det_F`); otherwise the attempt counts
 as failed with status ``inverted`` and is cut back like any other failure.
 A path that ends ``inverted`` names the worst cell in ``StepRecord.message``.
+A converged solve in which the weak springs of a stabilised body carry more
+than 1e-2 of the load (:func:`~fenics_contact.model.springs.spring_held`) is
+no answer either: status ``held_by_springs``, cut back the same way.
 """
 
 from __future__ import annotations
@@ -26,6 +29,7 @@ import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 
+from fenics_contact.model.springs import spring_held
 from fenics_contact.model.state import combined_state
 from fenics_contact.solvers.base import SolveResult, Strategy
 from fenics_contact.solvers.diagnostics import Status, admissibility
@@ -289,12 +293,16 @@ def _settle(strategy: Strategy, t: float) -> None:
 
 
 def _failure_message(record: StepRecord, t_try: float, refused: str | None = None,
-                     earlier: tuple[int, str] | None = None) -> str:
+                     earlier: tuple[int, str] | None = None, springs: str | None = None) -> str:
     """Why a step failed, in words.
 
     ``refused``: the last attempt's refusal; ``earlier``: (attempt number,
-    reason) of an earlier attempt's, named when the last one was not refused.
+    reason) of an earlier attempt's, named when the last one was not refused;
+    ``springs``: why the last attempt's converged state was no answer
+    (:func:`~fenics_contact.model.springs.spring_held`).
     """
+    if record.status == Status.HELD_BY_SPRINGS:
+        return f"{springs} (at load factor {t_try:.4g} after {_attempts(record)})"
     if record.status == Status.INVERTED:
         x = ", ".join(f"{c:.4g}" for c in record.worst_cell)
         return (
@@ -402,15 +410,17 @@ def solve_load_path(
             if on_iteration is not None:
                 on_iteration(step, result)
             status = result.status
+            springs: str | None = None  # why a converged attempt is no answer
             if result.converged:
                 det = problem.min_det_F()
                 step.min_det_F, step.worst_cell = det.value, det.where
-                if det.value > 0.0:
+                springs = spring_held(problem) if det.value > 0.0 else None
+                if det.value > 0.0 and springs is None:
                     t = t_try
                     halvings = 0
                     continue
-                status = Status.INVERTED
-            refused = refusal(strategy, result) if status is not Status.INVERTED else None
+                status = Status.INVERTED if springs is None else Status.HELD_BY_SPRINGS
+            refused = refusal(strategy, result) if not result.converged else None
             if refused is not None:
                 earlier = (attempts, refused)
             problem.restore(saved)
@@ -422,7 +432,7 @@ def solve_load_path(
                 step.status = status.value
                 step.load_factor = t
                 step.failed_at = t_try
-                step.message = _failure_message(step, t_try, refused, earlier)
+                step.message = _failure_message(step, t_try, refused, earlier, springs)
                 _settle(strategy, t)
                 break
             increment /= 2

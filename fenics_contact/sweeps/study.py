@@ -157,6 +157,7 @@ STATUS_WORDS = {
     Status.DIVERGED.value: "divergence",
     Status.MAX_ITERATIONS.value: "> {limit}",
     Status.INVERTED.value: "inverted",
+    Status.HELD_BY_SPRINGS.value: "held by springs",
     Status.ERROR.value: "error",
 }
 
