@@ -133,12 +133,14 @@ def warn_pressure_scatter(scene: Scene, problem: ContactProblem) -> float:
                    "a smooth pressure, tag the two parts that meet apart and pair them with "
                    'discretisation = "mortar" (docs/contacts.md).')
         else:
-            why = ("the nodes sample the partner's facets unevenly on meshes that do not "
-                   "match (on curved faces also the chords of coarser target facets), and "
-                   "refining removes it slowly if at all (on flat faces not at all; the "
-                   "chords' part falls about with h). discretisation = \"mortar\" gives a "
-                   "smooth pressure (docs/two_bodies.md); the resultant force is right "
-                   "either way.")
+            why = ("one-pass node-to-segment on meshes that do not match misses the patch "
+                   "test: the nodes sample the partner's facets unevenly (on curved faces "
+                   "also the chords of coarser target facets), so the pressures spread and "
+                   "the resultant force may be off by per cents (a uniformly pressed stack "
+                   "of three blocks: -1.5 %), and refining removes it slowly if at all (on "
+                   "flat faces not at all; the chords' part falls about with h). Fix: "
+                   "discretisation = \"mortar\" passes the patch test, with a smooth "
+                   "pressure and the exact resultant there (docs/two_bodies.md).")
         declared = contact.name in {p.name for p in scene.pairs}
         label = (f"[[pair]] {contact.name!r}" if declared else
                  f"[pairing] automatic contact {contact.name!r}")
