@@ -792,12 +792,32 @@ def slip_at_projection(pair: DeformablePair, u: fem.Function, u_prev: fem.Functi
     return tangents, tangents.T * ((u - u_prev) - target)
 
 
+def check_pair_cells(domain: mesh.Mesh, name: str) -> None:
+    """Refuse a pair on cells whose facets its search cannot handle (ValueError).
+
+    In 3D the node-to-segment and mortar pairs work on triangle facets
+    (tetrahedra); hexahedra give quadrilateral facets. In 2D every facet is
+    a segment (triangles and quadrilaterals alike).
+    """
+    cell = domain.topology.cell_type
+    if domain.topology.dim == 3 and cell != mesh.CellType.tetrahedron:
+        raise ValueError(
+            f"Contact pair {name!r}: the mesh's cells are {cell.name} (facets: "
+            f"{'quadrilaterals' if cell == mesh.CellType.hexahedron else 'not triangles'}); "
+            "node-to-segment and mortar pairs in 3D need triangle facets. Mesh the bodies "
+            "with tetrahedra (gmsh: leave out Recombine and Transfinite Volume); rigid "
+            "obstacles work on hexahedra."
+        )
+
+
 def bind_pair_bodies(contact: Contact, solid) -> None:
     """Set a pair's ``striker_body`` and ``target_body`` and its r scale's modulus.
 
     The bodies are named by the contact (``_names``) or found from its facets;
-    the modulus is the harmonic mean 2 E_s E_t / (E_s + E_t) (stress).
+    the modulus is the harmonic mean 2 E_s E_t / (E_s + E_t) (stress). Pairs
+    on cells they cannot handle are refused first (:func:`check_pair_cells`).
     """
+    check_pair_cells(solid.domain, contact.name)
     bodies = [
         solid.body_of_facets(facets, role) if name is None else _named(solid, name, role)
         for name, facets, role in zip(contact._names, (contact.facets, contact.target_facets),

@@ -25,7 +25,7 @@ from fenics_contact.model.materials import material
 from fenics_contact.model.mortar import MortarContact
 from fenics_contact.model.obstacle_contact import ObstacleContact
 from fenics_contact.model.obstacles import RigidBall, RigidObstacle, RigidPlane
-from fenics_contact.model.pairs import NodeToSegmentContact
+from fenics_contact.model.pairs import NodeToSegmentContact, check_pair_cells
 from fenics_contact.model.problem import (
     Body,
     ContactProblem,
@@ -380,6 +380,10 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
         striker = tagged_facets(body, scene, f"[[pair]] {pair.name!r} striker", pair.striker)
         target = tagged_facets(body, scene, f"[[pair]] {pair.name!r} target", pair.target)
         check_pair_surfaces(scene, body.domain, body.cell_tags, bodies, striker, target, pair)
+        try:
+            check_pair_cells(body.domain, pair.name)
+        except ValueError as exc:
+            raise SceneError(f"{scene.path.name}: {exc}") from None
         if not pair.self_contact:
             check_pair_surfaces_face(scene, body.domain, striker, target, pair,
                                      lambda pair=pair, target=target: _surfaces_beside(
