@@ -109,3 +109,36 @@ def test_a_body_tag_without_cell_tags_and_a_facet_mask_are_named():
     plane = RigidPlane(domain, [0.0, 0.0], [0.0, 1.0])
     with pytest.raises(TypeError, match=r"facets must be facet indices.*np.flatnonzero\(mask\)"):
         ObstacleContact(plane, [True, False], ContactSettings())
+
+
+def _facet_problem(contact_of):
+    """A block of 8 x 4 quadrilaterals (76 facets) with ``contact_of(domain, bottom)``."""
+    domain = mesh.create_rectangle(MPI.COMM_WORLD, [[0.0, 0.0], [W, H]], [8, 4],
+                                   mesh.CellType.quadrilateral)
+    bottom = mesh.locate_entities_boundary(domain, 1, lambda x: np.isclose(x[1], 0.0))
+    solid = Solid(domain, [Body("block", None, material("linear", E, NU))])
+    return ContactProblem(solid, [contact_of(domain, bottom)])
+
+
+def test_out_of_range_facets_are_named_with_the_valid_range():
+    """Before: numpy's "IndexError: index 1000000 is out of bounds for axis 0 with size 76"."""
+    from fenics_contact import MortarContact, NodeToSegmentContact
+
+    settings = ContactSettings(r=10.0)
+    cases = {
+        "ObstacleContact 'floor': facets": lambda d, b: ObstacleContact(
+            RigidPlane(d, [0.0, 0.0], [0.0, 1.0]), np.array([3, 10**6]), settings, name="floor"),
+        "NodeToSegmentContact 'nts': target_facets": lambda d, b: NodeToSegmentContact(
+            b, np.array([-1, 10**6, 76]), settings, name="nts"),
+        "MortarContact 'mortar': striker_facets": lambda d, b: MortarContact(
+            np.array([76]), b, settings, name="mortar"),
+    }
+    said = {}
+    for where, contact_of in cases.items():
+        with pytest.raises(ValueError) as err:
+            _facet_problem(contact_of)
+        said[where] = str(err.value)
+        assert said[where].startswith(f"{where}: ")
+        assert "local facet indices run from 0 to 75" in said[where]
+    nts = said["NodeToSegmentContact 'nts': target_facets"]
+    assert "3 facet index(es) out of range (-1, 76, 1000000)" in nts

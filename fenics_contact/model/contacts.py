@@ -92,6 +92,10 @@ class Contact:
         self.friction: CoulombFriction | None = None
         self.name = name
 
+    def facet_arguments(self) -> dict[str, np.ndarray]:
+        """The facet index arrays this contact was given, by argument name."""
+        return {"facets": self.facets}
+
     @property
     def frictional(self) -> bool:
         """Whether the contact carries Coulomb friction."""

@@ -343,6 +343,10 @@ class MortarContact(Contact):
         self._slots = slots
         self._target_force_forms: list[fem.Form] | None = None
 
+    def facet_arguments(self) -> dict[str, np.ndarray]:
+        """The striker and target facet index arrays, by argument name."""
+        return {"striker_facets": self.facets, "target_facets": self.target_facets}
+
     def _bind_partner(self, solid) -> ufl.core.expr.Expr:
         from fenics_contact.model.pairs import bind_pair_bodies
 

@@ -624,6 +624,10 @@ class NodeToSegmentContact(Contact):
         self._target_force_forms: list[fem.Form] | None = None
         self._lam_of_w: np.ndarray | None = None
 
+    def facet_arguments(self) -> dict[str, np.ndarray]:
+        """The striker and target facet index arrays, by argument name."""
+        return {"striker_facets": self.facets, "target_facets": self.target_facets}
+
     def _bind_partner(self, solid) -> ufl.core.expr.Expr:
         if solid.degree != 1:
             raise ValueError(

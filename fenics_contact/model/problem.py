@@ -51,7 +51,7 @@ from fenics_contact.model.residuals import (
     penalty_energy,
 )
 from fenics_contact.model.state import ContactState, ProblemState, combined_state
-from fenics_contact.model.tags import facet_roles
+from fenics_contact.model.tags import check_facet_indices, facet_roles
 from fenics_contact.model.variational_system import Transfers, VariationalSystem, Work
 
 
@@ -80,6 +80,10 @@ class ContactProblem(FrictionalContacts):
         self.load_factor = 0.0
         #: The load factor of the last :meth:`commit` (the start of the slip increment).
         self.committed_load_factor = 0.0
+        for c in self.contacts:  # before any use of the facets
+            for argument, facets in c.facet_arguments().items():
+                check_facet_indices(self.domain, facets,
+                                    f"{type(c).__name__} {c.name!r}: {argument}")
         groups = [c.facets for c in self.contacts] + [t.facets for t in solid.tractions]
         self.facet_tags, ids = facet_roles(self.domain, groups)
         for contact, tag_ids in zip(self.contacts, ids, strict=False):

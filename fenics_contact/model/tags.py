@@ -16,6 +16,25 @@ import numpy as np
 from dolfinx import mesh
 
 
+def check_facet_indices(domain: mesh.Mesh, facets: np.ndarray, where: str) -> None:
+    """Refuse facet indices outside the mesh's local facets (ValueError naming them).
+
+    ``where`` names the argument, e.g. "ObstacleContact 'floor': facets".
+    Local facet indices (owned and ghosts) run from 0 to the count - 1.
+    """
+    fdim = domain.topology.dim - 1
+    domain.topology.create_entities(fdim)
+    im = domain.topology.index_map(fdim)
+    count = im.size_local + im.num_ghosts
+    bad = np.unique(facets[(facets < 0) | (facets >= count)])
+    if bad.size:
+        shown = ", ".join(str(int(f)) for f in bad[:5]) + (", ..." if bad.size > 5 else "")
+        raise ValueError(
+            f"{where}: {bad.size} facet index(es) out of range ({shown}); the mesh's local "
+            f"facet indices run from 0 to {count - 1}. Give facets of this mesh (e.g. "
+            "facet_tags.find(tag) or mesh.locate_entities_boundary(mesh, dim - 1, where)).")
+
+
 def facet_roles(
     domain: mesh.Mesh, groups: Sequence[np.ndarray]
 ) -> tuple[mesh.MeshTags, list[tuple[int, ...]]]:
