@@ -283,7 +283,10 @@ def scene_atol(scene: Scene, problem: ContactProblem) -> Scene:
     about 1e10) an absolute 1e-8 lies below the round-off of the forces and
     no step converges (a block on a plane, E = 2.1e11, was refused as
     cycling at 1e-6). Left out, atol is max(1e-8, 1e-12 E h^(d-1)); every
-    shipped scene (E h^(d-1) <= 1e4) keeps 1e-8.
+    shipped scene (E h^(d-1) <= 1e4) keeps 1e-8. The one place the default
+    is resolved: :func:`scene_strategy` (so every route, ``run`` and the
+    Python API alike) and :func:`run_scene` (its warnings and summary) read
+    it here. Idempotent.
     """
     from fenics_contact.model.scaling import force_scale
 
@@ -501,7 +504,12 @@ def _at_last_written_step(problem: ContactProblem, folder: Path, run_identity: d
 
 def scene_strategy(scene: Scene, problem: ContactProblem,
                    on_residual: Callable[[int, float], None] | None = None):
-    """The strategy of the scene's [solver] on ``problem`` (method, linear solver, predictor)."""
+    """The strategy of the scene's [solver] on ``problem`` (method, linear solver, predictor).
+
+    The stopping tolerance is the scene's atol as :func:`scene_atol` resolves
+    it (left out: it follows E h^(d-1)), the one ``fenics-contact run`` uses.
+    """
+    scene = scene_atol(scene, problem)
     return make_strategy(
         scene.solver.method, problem, scene.solver,  # a SolverSettings with stepping keys
         linear=LinearSolverSettings(

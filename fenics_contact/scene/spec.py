@@ -156,8 +156,9 @@ class SolverSpec(SolverSettings):
     """Stopping rules (:class:`SolverSettings`) plus strategy and load stepping."""
 
     rtol: float = 1e-10
-    #: Whether the scene gives atol; if not, the run raises it to 1e-12 E h^(d-1) where
-    #: that is larger (a large E in SI units: :func:`fenics_contact.runner.scene_atol`).
+    #: Whether the scene gives atol; if not, scene_strategy (and so the run) raises it to
+    #: 1e-12 E h^(d-1) where that is larger (a large E in SI units:
+    #: :func:`fenics_contact.runner.scene_atol`).
     atol_given: bool = False
     method: str = "gnrm"
     steps: int = 10
