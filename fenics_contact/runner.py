@@ -272,10 +272,6 @@ def _replace_earlier_run(comm: MPI.Comm, out: Path) -> None:
 LOOSE_ATOL = 1e-5
 
 
-#: atol a scene leaves out is at least this times its force unit E h^(d-1).
-SCENE_FORCE_ATOL = 1e-12
-
-
 def scene_atol(scene: Scene, problem: ContactProblem) -> Scene:
     """The scene with atol following the forces when the scene does not give it.
 
@@ -288,12 +284,11 @@ def scene_atol(scene: Scene, problem: ContactProblem) -> Scene:
     Python API alike) and :func:`run_scene` (its warnings and summary) read
     it here. Idempotent.
     """
-    from fenics_contact.model.scaling import force_scale
+    from fenics_contact.model.scaling import default_atol
 
     if scene.solver.atol_given:
         return scene
-    atol = max(scene.solver.atol, SCENE_FORCE_ATOL * force_scale(problem))
-    return replace(scene, solver=replace(scene.solver, atol=atol))
+    return replace(scene, solver=replace(scene.solver, atol=default_atol(problem)))
 
 
 #: Springs of a stabilised body carrying more than this share of its load are warned.
@@ -344,6 +339,36 @@ def _warn_loose_tolerance(scene: Scene, problem: ContactProblem) -> None:
         ), stacklevel=2)
 
 
+def _warn_tight_tolerance(scene: Scene, problem: ContactProblem) -> None:
+    """Warn when a given atol lies below the round-off of the residual (collective).
+
+    The complementarity rows r g A are formed from coordinates: their
+    round-off is eps r g_scale ||A||, and the residual was measured to stall
+    at 0.1-0.5 of it (three bodies at E = 2e6, atol = 1e-10: 3-6e-10 for 50
+    iterations, then max_iterations). Below that the run cannot converge.
+    """
+    from fenics_contact.model.scaling import (
+        below_roundoff,
+        contact_force_size,
+        force_scale,
+        suggested_atol,
+    )
+    from fenics_contact.scene.checks import SceneWarning
+
+    atol = scene.solver.atol
+    if not scene.solver.atol_given or not problem.contacts or not below_roundoff(problem, atol):
+        return
+    size = contact_force_size(problem)
+    eps = float(np.finfo(float).eps)
+    warnings.warn(SceneWarning(
+        f"{scene.path.name}: [solver] atol = {atol:g} lies below the round-off of this "
+        f"problem's residual, about {eps * size:.2g} (eps times its contact forces of size "
+        f"r g ||A|| = {size:.3g}; E h^(d-1) = {force_scale(problem):.3g}): "
+        f"Newton may stall above it and the step fail as max_iterations or cycling. Raise "
+        f"atol to about {suggested_atol(problem):.1g} (or leave it out: the default follows E)."
+    ), stacklevel=2)
+
+
 @contextmanager
 def _kept(notes: list[str]):
     """Keep the text of every SceneWarning issued inside in ``notes``, and issue it as usual."""
@@ -389,10 +414,9 @@ def run_scene(
     with _kept(notes):
         problem = build_problem(scene, comm)
         scene = scene_atol(scene, problem)
-        _warn_loose_tolerance(scene, problem)
         warn_slots_capped(problem)
-    used = contact_settings(problem)
-    strategy = scene_strategy(scene, problem, on_residual)
+        used = contact_settings(problem)  # before a strategy changes r
+        strategy = scene_strategy(scene, problem, on_residual)  # warns of atol
     saved = restore(out / "checkpoint", problem, marker) if marker is not None else None
     if isinstance(strategy, Extrapolated) and saved is not None and saved.history:
         strategy.history = saved.history
@@ -507,9 +531,12 @@ def scene_strategy(scene: Scene, problem: ContactProblem,
     """The strategy of the scene's [solver] on ``problem`` (method, linear solver, predictor).
 
     The stopping tolerance is the scene's atol as :func:`scene_atol` resolves
-    it (left out: it follows E h^(d-1)), the one ``fenics-contact run`` uses.
+    it (left out: it follows E h^(d-1)), the one ``fenics-contact run`` uses;
+    an atol too loose or below round-off for the problem's forces is warned.
     """
     scene = scene_atol(scene, problem)
+    _warn_loose_tolerance(scene, problem)
+    _warn_tight_tolerance(scene, problem)
     return make_strategy(
         scene.solver.method, problem, scene.solver,  # a SolverSettings with stepping keys
         linear=LinearSolverSettings(

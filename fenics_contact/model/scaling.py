@@ -35,6 +35,16 @@ FLOOR_FACTOR = 4.0
 #: Default stopping tolerance relative to the force scale E h^(d-1).
 DEFAULT_FORCE_RTOL = 1e-10
 
+#: A scene that leaves atol out stops at max(SCENE_ATOL, SCENE_FORCE_ATOL E h^(d-1)).
+SCENE_ATOL = 1e-8
+SCENE_FORCE_ATOL = 1e-12
+
+#: An atol below this share of eps r g_scale ||A|| lies under the level the residual
+#: stalls at. Measured: a three-body sandwich (r = 1 E/h, E = 2e6 and 2e9) stalled at
+#: 0.1-0.2 eps r g_scale ||A|| (3-6e-10 and 3-6e-7), the Example 2 analog at 0.3-0.5;
+#: a cylinder between plates reaches atol = 0.7 of it (5 iterations a step).
+BELOW_ROUNDOFF = 0.1
+
 
 def force_scale(problem: ContactProblem) -> float:
     """E h^(d-1): the force unit of the residual (force; per unit thickness in 2D)."""
@@ -75,9 +85,41 @@ def residual_floor(problem: ContactProblem, r: float | None = None) -> float:
     largest r counts. Returns ``FLOOR_FACTOR * eps * r * g_scale * ||A||``
     (force units).
     """
-    r_abs = (problem.r_absolute if r is None else float(r)) * max(problem.r_ratios())
     eps = float(np.finfo(float).eps)
-    return FLOOR_FACTOR * eps * r_abs * gap_scale(problem) * area_norm(problem)
+    return FLOOR_FACTOR * eps * contact_force_size(problem, r)
+
+
+def contact_force_size(problem: ContactProblem, r: float | None = None) -> float:
+    """The size r g_scale ||A|| of the forces whose round-off the residual carries (force).
+
+    The complementarity rows r g A are formed from coordinates of size
+    ``g_scale``; eps times this is the round-off of those rows (the residual's
+    floor is :data:`FLOOR_FACTOR` times it). 0 without contacts. Collective.
+    """
+    if not problem.contacts:
+        return 0.0
+    r_abs = (problem.r_absolute if r is None else float(r)) * max(problem.r_ratios())
+    return r_abs * gap_scale(problem) * area_norm(problem)
+
+
+def default_atol(problem: ContactProblem) -> float:
+    """The atol of a scene that leaves it out: max(1e-8, 1e-12 E h^(d-1)) (force).
+
+    Every shipped scene (E h^(d-1) <= 1e4) keeps 1e-8; steel in Pa follows its forces.
+    """
+    return max(SCENE_ATOL, SCENE_FORCE_ATOL * force_scale(problem))
+
+
+def suggested_atol(problem: ContactProblem) -> float:
+    """An atol above the round-off of ``problem``'s residual: the default, at least the floor."""
+    floor = residual_floor(problem) if problem.contacts else 0.0
+    return max(default_atol(problem), floor)
+
+
+def below_roundoff(problem: ContactProblem, atol: float) -> bool:
+    """Whether ``atol`` lies below the level the residual stalls at (collective)."""
+    eps = float(np.finfo(float).eps)
+    return atol < BELOW_ROUNDOFF * eps * contact_force_size(problem)
 
 
 def scaled_atol(problem: ContactProblem, force_rtol: float = DEFAULT_FORCE_RTOL) -> float:

@@ -32,7 +32,7 @@ from dataclasses import asdict, dataclass, field
 from fenics_contact.model.springs import spring_held
 from fenics_contact.model.state import combined_state
 from fenics_contact.solvers.base import SolveResult, Strategy
-from fenics_contact.solvers.diagnostics import Status, admissibility
+from fenics_contact.solvers.diagnostics import ROUNDOFF_STALL, Status, admissibility, roundoff_stall
 
 
 @dataclass
@@ -292,14 +292,38 @@ def _settle(strategy: Strategy, t: float) -> None:
         kernel.assemble_residual()
 
 
+def stall_note(strategy: Strategy, residuals: list[float]) -> str | None:
+    """Why the residual of a failed attempt stopped falling, when it is round-off (collective).
+
+    The residual's round-off floor (:func:`~fenics_contact.model.scaling.residual_floor`,
+    FLOOR_FACTOR eps r g ||A||) bounds what any tolerance may demand: a
+    residual that sits below it over :data:`STALL_WINDOW` iterations without
+    falling is round-off, and only a larger atol ends the step.
+    """
+    from fenics_contact.model.scaling import contact_force_size, residual_floor, suggested_atol
+
+    problem = strategy.problem
+    if not problem.contacts:
+        return None
+    level = roundoff_stall(residuals, residual_floor(problem))
+    if level is None:
+        return None
+    return (f"the residual stalls at {level:.2g}, {ROUNDOFF_STALL} "
+            f"{contact_force_size(problem):.3g} (r g ||A||), above atol = "
+            f"{strategy.settings.atol:g}; raise atol to about {suggested_atol(problem):.1g} "
+            "(or leave it out of the scene: the default follows E)")
+
+
 def _failure_message(record: StepRecord, t_try: float, refused: str | None = None,
-                     earlier: tuple[int, str] | None = None, springs: str | None = None) -> str:
+                     earlier: tuple[int, str] | None = None, springs: str | None = None,
+                     stalled: str | None = None) -> str:
     """Why a step failed, in words.
 
     ``refused``: the last attempt's refusal; ``earlier``: (attempt number,
     reason) of an earlier attempt's, named when the last one was not refused;
     ``springs``: why the last attempt's converged state was no answer
-    (:func:`~fenics_contact.model.springs.spring_held`).
+    (:func:`~fenics_contact.model.springs.spring_held`); ``stalled``:
+    :func:`stall_note` of the last attempt, said first.
     """
     if record.status == Status.HELD_BY_SPRINGS:
         return f"{springs} (at load factor {t_try:.4g} after {_attempts(record)})"
@@ -312,6 +336,8 @@ def _failure_message(record: StepRecord, t_try: float, refused: str | None = Non
             "reduce the load, its initial penetration or r, or refine the mesh there"
         )
     message = f"{record.status} at load factor {t_try:.4g} after {_attempts(record)}"
+    if stalled:
+        message += f"; {stalled}"
     firsts = [r[0] for r in record.residuals if r]
     if firsts and not any(math.isfinite(r) for r in firsts):
         message += ("; the residual was NaN or infinite at its first evaluation in every attempt "
@@ -432,7 +458,9 @@ def solve_load_path(
                 step.status = status.value
                 step.load_factor = t
                 step.failed_at = t_try
-                step.message = _failure_message(step, t_try, refused, earlier, springs)
+                stalled = (stall_note(strategy, result.residuals) if refused is None
+                           and status in (Status.MAX_ITERATIONS, Status.CYCLING) else None)
+                step.message = _failure_message(step, t_try, refused, earlier, springs, stalled)
                 _settle(strategy, t)
                 break
             increment /= 2
