@@ -194,3 +194,51 @@ def _with_atol(path, atol: float):
     out = path.with_name("given.toml")
     out.write_text(text)
     return out
+
+
+PRESSED_FROM_TOUCHING = """
+[scene]
+name = "pressed-from-touching"
+dimension = 2
+[mesh]
+generator = "rectangle"
+size = [2.0, 1.0]
+cells = [8, 4]
+[material]
+law = "neo-hookean"
+E = 210.0
+nu = 0.3
+[[dirichlet]]
+tag = "left"
+value = [0.0, "free"]
+[[traction]]
+tag = "top"
+value = [0.0, -50.0]
+[obstacle]
+type = "plane"
+point = [0.0, 0.0]
+normal = [0.0, 1.0]
+[contact]
+tag = "bottom"
+r = 1.0
+[solver]
+method = "penalty"
+steps = 2
+"""
+
+
+@pytest.mark.parametrize("r", [1.0, 1e3])
+def test_penalty_presses_a_body_that_starts_touching(tmp_path, r):
+    """A block resting on the floor (gap 0), only a traction pressing it: the penalty
+    tangent took the open branch at g = 0, so nothing held the block vertically and the
+    first Newton step went to 1e16 ("diverged" at every cut-back). The floor carries the
+    traction's resultant 50 x 2 exactly, whatever the penalty's own penetration."""
+    from fenics_contact.runner import run_scene
+    from fenics_contact.scene.schema import load_scene
+
+    path = tmp_path / "touching.toml"
+    path.write_text(PRESSED_FROM_TOUCHING.replace("r = 1.0", f"r = {r}"))
+    steps = run_scene(load_scene(path), tmp_path / "out", pictures=False).path.steps
+    assert [s.status for s in steps] == ["converged", "converged"]
+    assert steps[-1].contact_force == pytest.approx(100.0, rel=1e-9)
+    assert sum(s.iterations for s in steps) <= 12

@@ -329,6 +329,14 @@ class StrikerOnFacetProblem:
         conditions = [(p.facets, p.at(1.0)) for p in self.solid.prescribed]
         return [("body", m) for m in free_rigid_motions(self.domain, conditions)]
 
+    def residual_roundoff(self) -> tuple[float, float, float]:
+        """Not measured here: zeros (see ContactProblem.residual_roundoff)."""
+        return 0.0, 0.0, 0.0
+
+    def stabilisation_forces(self) -> dict[str, np.ndarray]:
+        """No stabilised body here: {} (see ContactProblem.stabilisation_forces)."""
+        return {}
+
     def min_det_F(self):
         """Smallest det F over the body."""
         return self.solid.min_det_F()

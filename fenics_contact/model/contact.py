@@ -38,8 +38,15 @@ def assemble_local(compiled: fem.Form) -> np.ndarray:
 
 
 def penalty_energy(g: ufl.core.expr.Expr, r: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
-    """Penalty energy density r/2 min(g, 0)^2 (energy per reference area)."""
-    return 0.5 * r * ufl.min_value(g, 0) ** 2
+    """Penalty energy density r/2 min(g, 0)^2 (energy per reference area).
+
+    Written min(0, g): UFL differentiates min(a, b) as b's derivative where
+    a < b fails, so a touching node (g = 0) takes the closed branch in the
+    tangent. Written min(g, 0), it took the open one: a body that only
+    touches its support at the start had no stiffness there, and a load
+    pressing it sent the first Newton step to infinity.
+    """
+    return 0.5 * r * ufl.min_value(0, g) ** 2
 
 
 def augmented_lagrangian_energy(

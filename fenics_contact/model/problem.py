@@ -219,6 +219,23 @@ class ContactProblem(FrictionalContacts):
         """The entity maps of every contact submesh (for forms on them)."""
         return contact_entity_maps(self.contacts)
 
+    def residual_roundoff(self) -> tuple[float, float, float]:
+        """(floor, force size, atol to use) of the residual's round-off (force; collective).
+
+        The floor FLOOR_FACTOR eps r g ||A|| below which the residual cannot
+        fall, the size r g ||A|| of the forces it comes from, and an atol
+        above it (:mod:`~fenics_contact.model.scaling`); zeros without contacts.
+        """
+        from fenics_contact.model.scaling import (
+            contact_force_size,
+            residual_floor,
+            suggested_atol,
+        )
+
+        if not self.contacts:
+            return 0.0, 0.0, 0.0
+        return residual_floor(self), contact_force_size(self), suggested_atol(self)
+
     def r_ratios(self) -> list[float]:
         """Each contact's r over the first contact's r (1 for one contact)."""
         return [float(c.r.value) / self.r_absolute for c in self.contacts]

@@ -295,22 +295,17 @@ def _settle(strategy: Strategy, t: float) -> None:
 def stall_note(strategy: Strategy, residuals: list[float]) -> str | None:
     """Why the residual of a failed attempt stopped falling, when it is round-off (collective).
 
-    The residual's round-off floor (:func:`~fenics_contact.model.scaling.residual_floor`,
+    The residual's round-off floor (:meth:`~fenics_contact.model.problem.ContactProblem.residual_roundoff`,
     FLOOR_FACTOR eps r g ||A||) bounds what any tolerance may demand: a
     residual that sits below it over :data:`STALL_WINDOW` iterations without
     falling is round-off, and only a larger atol ends the step.
     """
-    from fenics_contact.model.scaling import contact_force_size, residual_floor, suggested_atol
-
-    problem = strategy.problem
-    if not problem.contacts:
-        return None
-    level = roundoff_stall(residuals, residual_floor(problem))
+    floor, size, atol = strategy.problem.residual_roundoff()
+    level = roundoff_stall(residuals, floor) if floor > 0.0 else None
     if level is None:
         return None
-    return (f"the residual stalls at {level:.2g}, {ROUNDOFF_STALL} "
-            f"{contact_force_size(problem):.3g} (r g ||A||), above atol = "
-            f"{strategy.settings.atol:g}; raise atol to about {suggested_atol(problem):.1g} "
+    return (f"the residual stalls at {level:.2g}, {ROUNDOFF_STALL} {size:.3g} (r g ||A||), "
+            f"above atol = {strategy.settings.atol:g}; raise atol to about {atol:.1g} "
             "(or leave it out of the scene: the default follows E)")
 
 
