@@ -295,8 +295,9 @@ def _settle(strategy: Strategy, t: float) -> None:
 def stall_note(strategy: Strategy, residuals: list[float]) -> str | None:
     """Why the residual of a failed attempt stopped falling, when it is round-off (collective).
 
-    The residual's round-off floor (:meth:`~fenics_contact.model.problem.ContactProblem.residual_roundoff`,
-    FLOOR_FACTOR eps r g ||A||) bounds what any tolerance may demand: a
+    The residual's round-off floor (FLOOR_FACTOR eps r g ||A||, see
+    :meth:`~fenics_contact.model.problem.ContactProblem.residual_roundoff`)
+    bounds what any tolerance may demand: a
     residual that sits below it over :data:`STALL_WINDOW` iterations without
     falling is round-off, and only a larger atol ends the step.
     """
