@@ -205,3 +205,30 @@ def test_auto_at_huge_r_under_the_scenes_predictor_gives_the_r_1_answer(tmp_path
     for ours, ref in zip(steps, reference, strict=True):
         assert abs(ours.contact_force - ref.contact_force) <= 1e-8 * ref.contact_force
         assert max(abs(f) for f in ours.reaction_total) <= 1e-10
+
+
+def test_auto_at_a_huge_r_on_a_stiff_soft_patch_test(tmp_path):
+    """Blocks of E = 2e6 on E = 200 (matching meshes), r = 1e10 E/h: the working-r
+    solves stalled at 1.2e-11 = 0.2 eps E h, the elastic rows' round-off, below atol but
+    above auto's own target at the working r (which counted only the contact rows'
+    round-off): 794 Newton iterations and a failure. Exact: 0.01 / (1/(2 E1*) + 1/(2 E2*))
+    with E* = E / (1 - nu^2) over the width 1 (plane strain, uniaxial)."""
+    from pathlib import Path
+
+    from fenics_contact.runner import run_scene
+    from fenics_contact.scene.schema import load_scene
+
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "scenes" / "block_on_block_node_to_segment.toml").read_text()
+    text = (text.replace('"../meshes/', f'"{root / "meshes"}/')
+            .replace("n_lower = 11", "n_lower = 8").replace("E = 200.0", "E = 2.0e6", 1)
+            .replace('target = "target_face"', 'target = "target_face"\nr = 1e10')
+            .replace('method = "gnrm"', 'method = "auto"'))
+    path = tmp_path / "stiff_soft.toml"
+    path.write_text(text)
+    outcome = run_scene(load_scene(path), tmp_path / "out", pictures=False)
+    assert outcome.path.converged
+    e1, e2 = 2.0e6 / (1 - 0.09), 200.0 / (1 - 0.09)
+    exact = 0.01 / (0.5 / e1 + 0.5 / e2)
+    assert outcome.path.steps[-1].contact_force == pytest.approx(exact, rel=1e-6)
+    assert outcome.path.iterations <= 20

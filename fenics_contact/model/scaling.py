@@ -82,11 +82,14 @@ def residual_floor(problem: ContactProblem, r: float | None = None) -> float:
     """Round-off floor of the static residual at ``r`` (absolute; default: current r).
 
     ``r`` is the first contact's; the others keep their ratio to it and the
-    largest r counts. Returns ``FLOOR_FACTOR * eps * r * g_scale * ||A||``
-    (force units).
+    largest r counts. Returns ``FLOOR_FACTOR * eps`` times the larger of
+    r g_scale ||A|| (the complementarity rows) and E h^(d-1) of the stiffest
+    body (the elastic rows: a patch test with a body of E = 2e6 stalled at
+    1.2e-11 = 0.2 eps E h, far above the contact rows' round-off at a small
+    working r) (force units).
     """
     eps = float(np.finfo(float).eps)
-    return FLOOR_FACTOR * eps * contact_force_size(problem, r)
+    return FLOOR_FACTOR * eps * max(contact_force_size(problem, r), force_scale(problem))
 
 
 def contact_force_size(problem: ContactProblem, r: float | None = None) -> float:

@@ -303,7 +303,7 @@ def stall_note(strategy: Strategy, residuals: list[float]) -> str | None:
     """
     floor, size, atol = strategy.problem.residual_roundoff()
     level = roundoff_stall(residuals, floor) if floor > 0.0 else None
-    if level is None:
+    if level is None or level <= strategy.settings.atol:  # a strategy's own tighter target
         return None
     return (f"the residual stalls at {level:.2g}, {ROUNDOFF_STALL} {size:.3g} (r g ||A||), "
             f"above atol = {strategy.settings.atol:g}; raise atol to about {atol:.1g} "
