@@ -186,8 +186,9 @@ def test_a_body_held_by_a_mortar_pair_touching_at_a_point_is_held(tmp_path):
     text = text.replace(bottom, '[[dirichlet]]\ntag = "bottom"\nvalue = [0.0, "free"]\n\n'
                         '[[obstacle]]\nname = "floor"\ntype = "plane"\npoint = [0.0, -1.0]\n'
                         'normal = [0.0, 1.0]\ntag = "bottom"\n')
-    text = text.replace("h_contact = 0.01", "h_contact = 0.02").replace("steps = 10",
-                                                                        "steps = 2")
+    assert "h_contact = 0.005" in text
+    text = text.replace("h_contact = 0.005", "h_contact = 0.02").replace("steps = 10",
+                                                                         "steps = 2")
     text = text.replace('"../meshes/', f'"{root / "meshes"}/')
     path = tmp_path / "on_floor.toml"
     path.write_text(text)
