@@ -52,6 +52,16 @@ def force_scale(problem: ContactProblem) -> float:
     return float(problem.material.E * problem.h ** (dim - 1))
 
 
+def dirichlet_stiffness(problem: ContactProblem) -> float:
+    """E h^(d-2): the stiffness that makes a Dirichlet row's x - x_D a force (force/length).
+
+    The force a mismatch of one length puts on a node of facet size h; the
+    divergence test weights the residual's Dirichlet rows with it
+    (:meth:`~fenics_contact.solvers.newton.NewtonKernel.force_norm`).
+    """
+    return force_scale(problem) / float(problem.h)
+
+
 def gap_scale(problem: ContactProblem) -> float:
     """Size of the numbers the gap is computed from (length).
 

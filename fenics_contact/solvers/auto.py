@@ -50,6 +50,7 @@ from fenics_contact.solvers.base import (
     NewtonStrategy,
     Observer,
     SolveResult,
+    force_measure,
     newton_loop,
     retry_lowering_r_t,
     timed,
@@ -290,6 +291,7 @@ class AutoStrategy(NewtonStrategy):
         monitor = ConvergenceMonitor(
             settings, observer=self._progress(tally),
             admissible=admissibility(self.problem, settings),
+            force=force_measure(self.kernel, self.problem),
         )
         if line_search:
             status, steps = self._line_search_loop(self.kernel, monitor)
@@ -347,7 +349,8 @@ class AutoStrategy(NewtonStrategy):
         for lam in p.normal_multipliers():
             lam.x.array[:] = 0.0
         monitor = ConvergenceMonitor(
-            replace(settings, rtol=max(settings.rtol, 1e-6)), observer=self._progress(tally)
+            replace(settings, rtol=max(settings.rtol, 1e-6)), observer=self._progress(tally),
+            force=force_measure(self._penalty, p),
         )
         status, steps = self._line_search_loop(self._penalty, monitor)
         tally.iterations += steps

@@ -10,6 +10,7 @@ from typing import Protocol
 import numpy as np
 
 from fenics_contact.model.problem import ContactProblem, VariationalSystem
+from fenics_contact.model.scaling import dirichlet_stiffness
 from fenics_contact.solvers.condensed import kernel_for
 from fenics_contact.solvers.diagnostics import (
     ConvergenceMonitor,
@@ -67,6 +68,16 @@ class Strategy(Protocol):
     def working_r(self) -> float:
         """The first contact's r the solve works at (absolute; the problem's unless rescaled)."""
         ...
+
+
+def force_measure(kernel: NewtonKernel, problem: ContactProblem) -> Callable[[float], float]:
+    """The force norm of ``kernel``'s last residual for the divergence test (force).
+
+    Its Dirichlet rows weighted by E h^(d-2) of ``problem``
+    (:func:`~fenics_contact.model.scaling.dirichlet_stiffness`).
+    """
+    stiffness = dirichlet_stiffness(problem)
+    return lambda norm: kernel.force_norm(norm, stiffness)
 
 
 def newton_loop(
@@ -238,6 +249,7 @@ class NewtonStrategy:
             settings, observer=self.observer,
             admissible=admissibility(self.problem, settings,
                                      exact_constraint=self.exact_constraint),
+            force=force_measure(self.kernel, self.problem),
         )
 
     def working_r(self) -> float:

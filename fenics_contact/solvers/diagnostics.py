@@ -3,7 +3,13 @@
 Statuses, with their defined tests (checked in this order each iteration):
 
 - ``diverged``: the residual is NaN/inf, a linear solve failed, or the
-  residual exceeds ``divergence_factor`` times the first residual of the solve.
+  residual exceeds ``divergence_factor`` times the first residual of the solve
+  (at least atol). Both are compared as forces: the Dirichlet rows (x - x_D,
+  a length) are weighted by a stiffness E h^(d-2)
+  (:meth:`~fenics_contact.solvers.newton.NewtonKernel.force_norm`). Unweighted,
+  a displacement-driven step starts from a length and continues with forces
+  that scale with E: steel in Pa went 0.017 -> 2e6 in one Newton step of a
+  linear problem and was "diverged", the same scene at E = 200 converged.
 - ``converged``: the residual norm is at most ``max(atol, rtol * first)`` and,
   for strategies that impose the constraint exactly, the Signorini
   conditions hold in their own units (:func:`signorini_admissibility`): no
@@ -82,7 +88,8 @@ class SolverSettings:
         atol: absolute tolerance on the L2 norm of the static residual (force).
         rtol: tolerance relative to the first residual of the solve (0 disables).
         max_iterations: Newton iterations allowed in one solve (one load step).
-        divergence_factor: residual growth over the first residual that means divergence.
+        divergence_factor: growth of the residual's force norm over the first
+            one (at least atol) that means divergence.
         cycle_window: iterations inspected by the cycling test.
         gap_tol: largest nodal penetration accepted at convergence, relative
             to the contact facet size h (multiplier strategies only).
@@ -140,7 +147,13 @@ class ConvergenceMonitor:
     admissible: Callable[[], str | None] | None = None
     #: The last reason ``admissible`` gave for refusing convergence.
     refused: str | None = None
+    #: The force norm of a recorded residual (Dirichlet rows weighted by a stiffness,
+    #: :meth:`~fenics_contact.solvers.newton.NewtonKernel.force_norm`) for the
+    #: divergence test; None: the residual itself.
+    force: Callable[[float], float] | None = None
     residuals: list[float] = field(default_factory=list)
+    #: The force norm of every recorded residual (force).
+    forces: list[float] = field(default_factory=list)
     states: list[Hashable] = field(default_factory=list)
     status: Status | None = None
 
@@ -166,11 +179,14 @@ class ConvergenceMonitor:
         self.states.append(state if state is not None else round(math.log10(residual + 1e-300), 3)
                            if math.isfinite(residual) else None)
         s = self.settings
-        if not math.isfinite(residual):
+        finite = math.isfinite(residual)
+        self.forces.append(self.force(float(residual)) if finite and self.force is not None
+                           else float(residual))
+        if not finite:
             self.status = Status.DIVERGED
         elif residual <= self.tolerance() and self._accepted():
             self.status = Status.CONVERGED
-        elif residual > s.divergence_factor * max(self.residuals[0], s.atol):
+        elif self.forces[-1] > s.divergence_factor * max(self.forces[0], s.atol):
             self.status = Status.DIVERGED
         elif self._cycling():
             self.status = Status.CYCLING

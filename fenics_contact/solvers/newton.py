@@ -83,6 +83,8 @@ class NewtonKernel:
         self._keep: tuple = ()
         self.linear_solves = 0
         self.residual_norm = np.inf
+        #: Norm of the Dirichlet rows (x - x_D, length) of the last assembled residual.
+        self.dirichlet_norm = 0.0
         self.forcing: EisenstatWalker | None = None
         self.lag: PreconditionerLag | None = None
         #: The linear model's exact contact set at each step
@@ -165,7 +167,21 @@ class NewtonKernel:
         """Assemble F at the current unknowns; return and store its norm."""
         self.residual_norm = self._assemble_b()
         self.timings.residuals += 1
+        held = self.b.getArray(readonly=True)[self._support_dofs()]
+        comm = self.b.comm.tompi4py()
+        self.dirichlet_norm = float(np.sqrt(comm.allreduce(float(held @ held))))
         return self.residual_norm
+
+    def force_norm(self, norm: float, stiffness: float) -> float:
+        """``norm`` with the last residual's Dirichlet rows weighted by ``stiffness`` (force).
+
+        ``norm`` is a residual norm that holds the rows of the last
+        :meth:`assemble_residual` (x - x_D, length) among force rows; they are
+        replaced by ``stiffness`` (x - x_D), so every row is a force and the
+        result scales with E for the same problem in any units.
+        """
+        d = self.dirichlet_norm
+        return float(np.sqrt(max(norm * norm - d * d, 0.0) + (stiffness * d) ** 2))
 
     def _assemble_b(self) -> float:
         """Hook: the residual F into b (Dirichlet rows x - x_D); return its norm."""
