@@ -29,19 +29,12 @@ from dolfinx import default_scalar_type, fem
 WAIT_S = 600
 
 
-#: gcc flags of the contact kernels (MBs of straight-line C): -O1, with the register
-#: allocator's cheaper algorithm over one region. On the 2D mortar kernel of the
-#: two cylinders (4.4 MB of C) gcc takes 24.5 s of CPU against 29.3 s at plain
-#: -O1, 0.56 s at -O0 being 2.3x slower to assemble; the Newton iteration costs
-#: the same (0.0557 against 0.0559 s, side by side; docs/benchmarks.md).
-def _gcc() -> bool:
-    """True when cffi compiles with gcc (the register-allocator flags are gcc's)."""
-    compiler = os.environ.get("CC") or sysconfig.get_config_var("CC") or ""
-    return "gcc" in compiler.split()[0] if compiler else False
-
-
-CONTACT_CFLAGS = ["-O1", "-g0"] + (["-fira-region=one", "-fira-algorithm=priority"]
-                                   if _gcc() else [])
+#: C flags of the contact kernels (MBs of straight-line C): -O1 compiles them in a
+#: fraction of -O2's time and assembles as fast; -O0 assembles 2.3x slower. Tried:
+#: gcc's cheaper register allocation (-fira-region=one -fira-algorithm=priority)
+#: took 24.5 s of CPU against 29.3 s on the 4.4 MB 2D mortar kernel but 227 s
+#: against 149 s on an 11.4 MB frictional one (docs/benchmarks.md).
+CONTACT_CFLAGS = ["-O1", "-g0"]
 
 
 def _flat(forms: Any) -> Iterator[ufl.Form]:
