@@ -14,8 +14,6 @@ compilation is DOLFINx's own code.
 
 from __future__ import annotations
 
-import os
-import sysconfig
 from collections.abc import Iterator
 from typing import Any
 
