@@ -841,20 +841,26 @@ def test_a_solid_refuses_cells_of_no_body():
     Solid(domain, [Body("left", 1, law), Body("right", 2, law)], cell_tags=tags)
 
 
-def test_a_pair_whose_target_is_the_far_side_of_its_body_is_named(tmp_path):
-    """The target given as the far face of the right body (both outward normals down) read
-    as bodies "0.4 inside each other", or, with nothing else holding a body, as a free
-    translation. It is now refused as surfaces that nowhere face each other, with the
-    target body's surface that does face the striker."""
+@pytest.mark.parametrize("edit, named", [
+    (('target = "bottom_topside"', 'target = "floor_face"'),
+     r"striker = 'middle_underside' and target = 'floor_face' nowhere face each other.*"
+     r"target = 'bottom_topside' faces the striker\."),
+    (('striker = "middle_underside"', 'striker = "middle_topside"'),
+     r"striker = 'middle_topside' and target = 'bottom_topside' nowhere face each other.*"
+     r"striker = 'middle_underside' faces the target\."),
+])
+def test_a_pair_tag_on_the_far_side_of_its_body_is_named(tmp_path, edit, named):
+    """A target (or striker) given as the far face of the right body read as bodies "0.4
+    inside each other", or, with nothing else holding a body, as a free translation. It is
+    refused as surfaces that nowhere face each other (normals opposed and each in front of
+    the other), naming the surface of that body that does face the other one."""
     from fenics_contact.scene.build import build_problem
 
     root = Path(__file__).resolve().parents[1]
     text = (root / "scenes" / "stack_3_blocks.toml").read_text().replace(
         '"../meshes/', f'"{root / "meshes"}/')
     path = tmp_path / "far_side.toml"
-    path.write_text(text.replace('target = "bottom_topside"', 'target = "floor_face"'))
+    path.write_text(text.replace(*edit))
     with pytest.raises(SceneError, match=r"far_side.toml: \[\[pair\]\] 'middle-on-bottom': "
-                       r"striker = 'middle_underside' and target = 'floor_face' nowhere face "
-                       r"each other.*the surface of that body that faces it is "
-                       r"'bottom_topside'\."):
+                       + named):
         build_problem(load_scene(path))

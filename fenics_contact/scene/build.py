@@ -385,9 +385,10 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
         except ValueError as exc:
             raise SceneError(f"{scene.path.name}: {exc}") from None
         if not pair.self_contact:
-            check_pair_surfaces_face(scene, body.domain, striker, target, pair,
-                                     lambda pair=pair, target=target: _surfaces_beside(
-                                         scene, body, bodies, pair, target))
+            check_pair_surfaces_face(
+                scene, body.domain, striker, target, pair,
+                lambda role, pair=pair, facets={"striker": striker, "target": target}:
+                _surfaces_beside(body, bodies, pair, facets[role]))
         friction = (None if pair.mu is None
                     else FrictionSettings(pair.mu, pair.tangential_r_max))
         settings = ContactSettings(r=pair.r, relative=pair.relative,
@@ -416,10 +417,10 @@ def build_two_body_problem(scene: Scene, body: BodyMesh) -> ContactProblem:
     return problem
 
 
-def _surfaces_beside(scene: Scene, body: BodyMesh, bodies: list[Body], pair: PairSpec,
-                     target: np.ndarray) -> dict[str, np.ndarray]:
-    """The other named facet groups of the pair's target body (collective)."""
-    owner = facet_owners(body.domain, body.cell_tags, bodies, target)
+def _surfaces_beside(body: BodyMesh, bodies: list[Body], pair: PairSpec,
+                     facets_of: np.ndarray) -> dict[str, np.ndarray]:
+    """The other named facet groups of the body that holds ``facets_of`` (collective)."""
+    owner = facet_owners(body.domain, body.cell_tags, bodies, facets_of)
     found = {}
     for name in sorted(body.names):
         if name in (pair.striker, pair.target):

@@ -173,20 +173,44 @@ def check_pair_surfaces(
         )
 
 
-def _gathered_normals(domain: mesh.Mesh, facets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Outward normals and centres of facets, from every rank (reference configuration)."""
+#: Facets count as facing while neither lies more than this many facet sizes behind
+#: the other (surfaces meshed touching or overlapping a little: interference fits).
+FACING_SLACK = 3.0
+#: How many of the target facets nearest to each striker facet are looked at.
+FACING_NEIGHBOURS = 16
+
+
+def _surface(domain: mesh.Mesh, facets: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    """Outward normals and centres of facets from every rank, and the largest facet size."""
     normal, centre = outward_facet_normals(domain, facets)
-    return tuple(np.concatenate(domain.comm.allgather(a)) for a in (normal, centre))
+    size = 0.0
+    if facets.size:
+        corners = domain.geometry.x[mesh.entities_to_geometry(domain, domain.topology.dim - 1,
+                                                              facets)]
+        size = float(np.linalg.norm(corners[:, :, None] - corners[:, None], axis=-1).max())
+    normal, centre = (np.concatenate(domain.comm.allgather(a)) for a in (normal, centre))
+    return normal, centre, domain.comm.allreduce(size, op=MPI.MAX)
 
 
-def _nearest_alignment(striker: tuple[np.ndarray, np.ndarray],
-                       target: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
-    """n_s . n_t of each striker facet with the target facet nearest to it (-1: facing)."""
+def _facing(striker: tuple, target: tuple, slack: float | None) -> bool:
+    """True when some striker facet faces one of its nearest target facets.
+
+    Facing: outward normals opposed (n_s . n_t < -0.1) and, unless ``slack``
+    is None, each facet in front of the other to within ``slack`` (length).
+    """
     from scipy.spatial import cKDTree
 
-    (ns, cs), (nt, ct) = striker, target
-    _, nearest = cKDTree(ct).query(cs)
-    return np.einsum("ij,ij->i", ns, nt[nearest])
+    (ns, cs, _), (nt, ct, _) = striker, target
+    if cs.shape[0] == 0 or ct.shape[0] == 0:
+        return False
+    k = min(FACING_NEIGHBOURS, ct.shape[0])
+    idx = cKDTree(ct).query(cs, k=k)[1].reshape(cs.shape[0], k)
+    facing = np.einsum("ni,nki->nk", ns, nt[idx]) < -0.1
+    if slack is not None:
+        d = ct[idx] - cs[:, None]
+        facing &= (np.einsum("nki,ni->nk", d, ns) > -slack) & (
+            np.einsum("nki,nki->nk", -d, nt[idx]) > -slack)
+    return bool(np.any(facing))
 
 
 def check_pair_surfaces_face(
@@ -195,37 +219,39 @@ def check_pair_surfaces_face(
     striker: np.ndarray,
     target: np.ndarray,
     pair: PairSpec,
-    alternatives: Callable[[], dict[str, np.ndarray]],
+    beside: Callable[[str], dict[str, np.ndarray]],
 ) -> None:
     """Refuse a pair whose surfaces nowhere face each other.
 
-    A striker can only touch target facets whose outward normals oppose its
-    own. When the target facet nearest to every striker facet has its
-    outward normal along the striker's (n_s . n_t > 1/2 everywhere), the
-    target names a face of the right body turned the wrong way (its far
-    side): the projection then reads the bodies as deeply inside each
-    other, or the pair never closes and the body is reported free.
-    ``alternatives``: the other named surfaces of the target's body (called
-    on refusal only; collective), offered when one of them faces the striker.
+    A striker facet can only touch a target facet whose outward normal
+    opposes its own. When no striker facet has such a facet among its
+    nearest target facets, one of the tags names a face of the right body
+    turned the wrong way (its far side): the projection then reads the
+    bodies as deeply inside each other, or the pair never closes and the
+    body is reported free. (Opposed surfaces that start deep inside each
+    other are the overlap check's.) ``beside(role)``: the other named
+    surfaces of the striker's or the target's body (called on refusal only;
+    collective); those that face the other surface, normals opposed and
+    each in front of the other, are offered.
     """
-    s = _gathered_normals(domain, striker)
-    t = _gathered_normals(domain, target)
-    if s[0].shape[0] == 0 or t[0].shape[0] == 0:
+    s, t = _surface(domain, striker), _surface(domain, target)
+    if s[1].shape[0] == 0 or t[1].shape[0] == 0 or _facing(s, t, None):
         return
-    alignment = _nearest_alignment(s, t)
-    if alignment.min() <= 0.5:
-        return
-    facing_names = [name for name, facets in alternatives().items()
-                    if _nearest_alignment(s, _gathered_normals(domain, facets)).min() < -0.5]
-    fix = (f"the surface of that body that faces it is {' or '.join(map(repr, facing_names))}"
-           if facing_names else "give the target surface of the other body that faces it")
-    gdim = domain.geometry.dim
+    slack = FACING_SLACK * max(s[2], t[2])
+    targets = [name for name, facets in beside("target").items()
+               if _facing(s, _surface(domain, facets), slack)]
+    strikers = [name for name, facets in beside("striker").items()
+                if _facing(_surface(domain, facets), t, slack)]
+    hints = ([f"target = {' or '.join(map(repr, targets))} faces the striker"] if targets
+             else []) + ([f"striker = {' or '.join(map(repr, strikers))} faces the target"]
+                         if strikers else [])
+    fix = ("; ".join(hints) if hints
+           else "give the surfaces of the two bodies that face each other")
     raise SceneError(
         f"{scene.path.name}: [[pair]] {pair.name!r}: striker = {pair.striker!r} and target = "
-        f"{pair.target!r} nowhere face each other: the target's facets nearest to the "
-        f"striker have outward normals along the striker's (e.g. {_where(t[0][0], gdim)} and "
-        f"{_where(s[0][0], gdim)} near {_where(s[1][0], gdim)}), so they could never touch; "
-        f"the target is probably the far side of its body: {fix}."
+        f"{pair.target!r} nowhere face each other (no striker facet has a target facet near "
+        "it whose outward normal opposes its own), so they could never touch; one "
+        f"of them is probably the far side of its body: {fix}."
     )
 
 
