@@ -372,3 +372,26 @@ def test_the_friction_profile_draws_the_traction_on_the_body_along_the_axis(tmp_
     assert slipping.sum() > 5
     assert np.all(profile["traction"][slipping] > 0.0)
     assert np.allclose(profile["traction"][slipping], profile["limit"][slipping], rtol=1e-6)
+
+
+def test_a_nodal_state_is_not_interpolated_over_the_3d_bodies():
+    """Stick/slip (0 open, 1 stick, 2 slip) on the deformed bodies' panel: interpolated over
+    the faces, the side of a block whose base slips and whose top is open showed a band of
+    "stick". The bodies are now grey and the states dots on the nodes that carry one."""
+    import pyvista
+
+    from fenics_contact.output.contact_view import draw_solid, stick_slip_style
+
+    grid = pyvista.ImageData(dimensions=(3, 3, 3)).cast_to_unstructured_grid()
+    states = np.where(np.asarray(grid.points)[:, 2] == 0.0, 2.0, 0.0)
+    grid.point_data[STICK_SLIP] = states
+    grid.point_data[PRESSURE] = np.zeros(grid.n_points)  # no pressed surface: one panel
+    _, plotter = draw_solid(grid, stick_slip_style(), name="stick slip", nodal=True)
+    drawn = [(a.mapper.dataset, bool(a.mapper.scalar_visibility))
+             for a in plotter.renderers[-1].actors.values()
+             if isinstance(a, pyvista.Actor) and a.mapper.dataset is not None]
+    plotter.close()
+    body, coloured = max(drawn, key=lambda d: d[0].n_points)
+    dots = [m for m, _ in drawn if m is not body]
+    assert not coloured  # the body itself is one grey
+    assert [m.n_points for m in dots] == [9]  # the 9 slipping base nodes, nothing between

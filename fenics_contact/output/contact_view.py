@@ -295,22 +295,32 @@ def add_contact_panel(plotter, view: ContactView, title: str, *, nodal: bool = F
     is positive (for a nodal state such as stick/slip, not to be interpolated).
     Returns the unit direction from the focal point to the camera as set.
     """
-    import pyvista
-
     surface = view.surface.copy()  # type: ignore[attr-defined]
     if nodal:
-        plotter.add_mesh(surface, color="#eeeeee", show_edges=True, edge_color="#888888",
-                         lighting=False)
-        values = np.asarray(surface.point_data[style["scalars"]])
-        nodes = pyvista.PolyData(np.asarray(surface.points)[values > 0])
-        nodes.point_data[style["scalars"]] = values[values > 0]  # type: ignore[index]
-        plotter.add_mesh(nodes, render_points_as_spheres=True, point_size=12, **style)
+        _add_nodal(plotter, surface, grey="#eeeeee", show_edges=True, edge_color="#888888",
+                   lighting=False, **style)
     else:
         plotter.add_mesh(surface, show_edges=True, edge_color="#888888", lighting=False,
                          **style)
     look_at_contact(plotter, view)
     plotter.add_text(title, position="lower_left", font_size=10)
     return camera_direction(plotter)
+
+
+def _add_nodal(plotter, mesh, *, grey: str, point_size: int = 12, **style: object) -> None:
+    """``mesh`` in ``grey`` and the nodal field ``style["scalars"]`` as dots where it is > 0.
+
+    Edge and lighting keywords (``show_edges``, ``edge_color``, ``lighting``)
+    go to the grey mesh, the others to the dots.
+    """
+    import pyvista
+
+    look = {k: style.pop(k) for k in ("show_edges", "edge_color", "lighting") if k in style}
+    plotter.add_mesh(mesh, color=grey, **look)
+    values = np.asarray(mesh.point_data[style["scalars"]])
+    nodes = pyvista.PolyData(np.asarray(mesh.points)[values > 0])
+    nodes.point_data[style["scalars"]] = values[values > 0]  # type: ignore[index]
+    plotter.add_mesh(nodes, render_points_as_spheres=True, point_size=point_size, **style)
 
 
 def camera_direction(plotter) -> np.ndarray:
@@ -385,7 +395,10 @@ def draw_solid(grid, style: dict[str, object], *, name: str, nodal: bool = False
         picture.panels.append(label)
     label = "deformed bodies" if BODY in grid.cell_data else "deformed body"
     plotter.subplot(0, columns - 1)
-    plotter.add_mesh(grid.copy(), show_edges=False, **style)
+    if nodal:  # a nodal state is not interpolated over the faces (stick between slip and open)
+        _add_nodal(plotter, grid.copy(), grey="#dddddd", **style)
+    else:
+        plotter.add_mesh(grid.copy(), show_edges=False, **style)
     bounds = np.array(grid.bounds).reshape(3, 2).T
     if context is not None:
         context(plotter, bounds)
