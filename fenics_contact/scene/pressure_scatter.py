@@ -14,7 +14,8 @@ of its contact zone (nodes whose neighbours, and their neighbours, are all in
 contact, so that the zone's edge, where a smooth profile bends most, does
 not count): the scatter of a node is |p_i - mean of its neighbours' p|. A
 warning names the pair when the median scatter exceeds :data:`SCATTER` of
-the zone's mean pressure. Measured on the final states: the pin's coarse
+the zone's mean pressure, or a tenth of the nodes' scatter exceeds
+:data:`TAIL` of it. Measured on the final states: the pin's coarse
 meshes 0.21 (the finer, matched ones 0.0014, its mortar pair 0.034), the
 non-matching patch test 0.16, the shipped two cylinders 0.053, Hertz on a
 rigid plane 0.0035.
@@ -38,6 +39,13 @@ if TYPE_CHECKING:
 
 #: Median nodal scatter, relative to the mean pressure, from which a pair is named.
 SCATTER = 0.1
+#: ... or the scatter of a tenth of the interior nodes (with at least TAIL_NODES of
+#: them), which a small 3D zone shows where its median does not: a hemisphere on a
+#: block, 17 interior nodes, median 0.056, 90th percentile 0.41, its nodal peak 23 %
+#: above Hertz (mortar 6 %); the shipped node-to-segment hemispheres 0.16, the two
+#: cylinders 0.074, a matching Cattaneo-Mindlin pair 0.009.
+TAIL = 0.2
+TAIL_NODES = 10
 
 
 def nodal_scatter(contact) -> tuple[np.ndarray, float]:
@@ -118,7 +126,8 @@ def warn_pressure_scatter(scene: Scene, problem: ContactProblem) -> float:
             continue
         ratio, every, mean = _ratio(contact)
         worst = max(worst, ratio)
-        if ratio <= SCATTER:
+        tail = float(np.percentile(every, 90)) if every.size >= TAIL_NODES else 0.0
+        if ratio <= SCATTER and tail <= TAIL:
             continue
         alike = _alike(problem, contact, others)
         if alike:
@@ -147,9 +156,11 @@ def warn_pressure_scatter(scene: Scene, problem: ContactProblem) -> float:
         warnings.warn(
             f"{scene.path.name}: {label}: node-to-segment pressures scatter "
             f"from node to node by {ratio:.0%} of their mean ({mean:.4g}) inside the contact "
-            f"zone (median over {every.size} nodes, largest {float(every.max()):.0%}): {why}",
+            f"zone (median over {every.size} nodes"
+            + (f", {tail:.0%} at the 90th percentile" if tail > TAIL else "")
+            + f", largest {float(every.max()):.0%}): {why}",
             SceneWarning, stacklevel=2)
     return worst
 
 
-__all__ = ["SCATTER", "nodal_scatter", "warn_pressure_scatter"]
+__all__ = ["SCATTER", "TAIL", "nodal_scatter", "warn_pressure_scatter"]
