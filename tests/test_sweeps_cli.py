@@ -15,6 +15,7 @@ from benchmarks.research import tradeoff as lab_tradeoff
 from benchmarks.robustness.stability_grid import full_grid
 from fenics_contact.cli import main
 from fenics_contact.cli.stability import run_cases
+from fenics_contact.solvers.stepping import RAISE_TOLERANCE
 
 SCENES = Path(__file__).resolve().parents[1] / "scenes"
 
@@ -43,9 +44,9 @@ def test_tradeoff_command_on_a_scene_writes_json_csv_table_and_plot(tmp_path):
     # GNRM converged at r = 1 E/h only: the reference's own point, and marked so
     gnrm = next(line for line in table.splitlines() if "| GNRM |" in line)
     assert "(the reference's own path)" in gnrm
-    # auto at r = 1 and 1e10 E/h works at r = 1 E/h: the reference to round-off
+    # auto at r = 1 and 1e10 E/h works at r = 1 E/h: the reference's own run too
     auto = next(line for line in table.splitlines() if "| Auto |" in line)
-    assert "(the reference's answer to round-off)" in auto
+    assert "(the reference's own path)" in auto
     assert (tmp_path / "tradeoff.png").stat().st_size > 10_000
 
 
@@ -136,7 +137,7 @@ def test_study_beside_another_scene_with_relative_r_fills_the_table(tmp_path):
                  "--relative", "--out", str(tmp_path)])
     assert code == 0
     lines = (tmp_path / "table.md").read_text().splitlines()
-    assert lines[0] == "| Method | source | r = 0.1 | r = 10 |"
+    assert lines[0] == "| Method | source | r = 0.1 E/h | r = 10 E/h |"
     rows = [line.split("|")[3:5] for line in lines[2:]]
     assert len(rows) == 2  # one per scene, every cell an iteration count
     assert all(cell.strip().isdigit() for row in rows for cell in row), lines
@@ -194,3 +195,118 @@ def test_stability_counts_match_run_with_the_same_contact_set(tmp_path, contact_
     (row,) = read_csv(tmp_path / "stab" / "stability.csv")
     assert row["status"] == "converged"
     assert int(row["iterations"]) == sum(s["iterations"] for s in run["steps"])
+
+
+BALL_ON_BLOCK = """
+[scene]
+name = "blk-ball"
+dimension = 2
+
+[mesh]
+generator = "rectangle"
+origin = [-1.0, 0.0]
+size = [2.0, 1.0]
+cells = [8, 4]
+
+[material]
+law = "neo-hookean"
+E = 1000.0
+nu = 0.3
+
+[[dirichlet]]
+tag = "top"
+value = [0.0, 0.0]
+
+[obstacle]
+type = "ball"
+centre = [0.0, -2.0]
+radius = 2.0
+motion = [0.0, {lift}]
+
+[contact]
+tag = "bottom"
+r = {r}
+
+[solver]
+method = "gnrm"
+steps = 4
+{solver}
+"""
+
+
+def _ball_scene(path: Path, r: float = 1.0, solver: str = "", lift: float = 0.08) -> Path:
+    path.write_text(BALL_ON_BLOCK.format(r=r, solver=solver, lift=lift))
+    return path
+
+
+def _run_iterations(scene: Path, out: Path) -> int:
+    assert main(["run", str(scene), "--out", str(out), "--quiet", "--no-pictures"]) in (0, 1)
+    return sum(s["iterations"] for s in json.loads((out / "summary.json").read_text())["steps"])
+
+
+def _help(command: str, capsys) -> str:
+    with pytest.raises(SystemExit):
+        main([command, "--help"])
+    return " ".join(capsys.readouterr().out.split())
+
+
+def test_study_counts_match_run_with_rtol_zero_as_its_help_says(tmp_path, capsys):
+    """GNRM at r = 100 E/h on the ball: study 19; run 15 with the scene rtol 1e-10, 19 with 0."""
+    said = _help("study", capsys)
+    assert 'contact_set = "sign", atol = --tol and rtol = 0' in said
+    assert main(["study", str(_ball_scene(tmp_path / "ball.toml")), "--methods", "gnrm",
+                 "--r", "100", "--relative", "--out", str(tmp_path / "study")]) == 0
+    (row,) = read_csv(tmp_path / "study" / "study.csv")
+    same = 'predictor = "previous"\ncontact_set = "sign"\natol = 1e-8\nmax_cutbacks = 0\n'
+    exact = _run_iterations(_ball_scene(tmp_path / "a.toml", 100, same + "rtol = 0.0"),
+                            tmp_path / "a")
+    scene_rtol = _run_iterations(_ball_scene(tmp_path / "b.toml", 100, same), tmp_path / "b")
+    assert (int(row["iterations"]), exact, scene_rtol) == (19, 19, 15)
+
+
+def test_tradeoff_counts_match_run_with_its_atol_as_its_help_says(tmp_path, capsys):
+    """Its atol, max(1e-10 E h^(d-1), floor) = 2.5e-8 here, is looser than the scene's 1e-8."""
+    said = _help("tradeoff", capsys)
+    assert "tighter than a scene" not in said and "that atol and rtol = 0" in said
+    assert main(["tradeoff", str(_ball_scene(tmp_path / "ball.toml")), "--methods", "gnrm",
+                 "--r", "1", "--repeats", "1", "--out", str(tmp_path / "trade")]) == 0
+    (row,) = read_csv(tmp_path / "trade" / "tradeoff.csv")
+    assert float(row["atol"]) == pytest.approx(2.5e-8) and float(row["r_working"]) == 1.0
+    same = (f'predictor = "previous"\ncontact_set = "sign"\natol = {row["atol"]}\n'
+            "rtol = 0.0\nmax_cutbacks = 0\n")
+    assert int(row["iterations"]) == _run_iterations(
+        _ball_scene(tmp_path / "a.toml", 1.0, same), tmp_path / "a")
+
+
+def test_stability_shows_a_converged_run_off_the_reference_and_names_a_loose_tolerance(
+        tmp_path, capsys):
+    """A ball grazing the block (N = 0.0585) at r = 1e10 E/h: atol 0.0544, its round-off floor.
+
+    The penalty method converged 1.4 % off the reference; it was shown as converged.
+    """
+    scene = _ball_scene(tmp_path / "graze.toml", lift=0.0001)
+    assert main(["stability", str(scene), "--r", "1e10", "--methods", "penalty,auto",
+                 "--out", str(tmp_path / "stab")]) == 0
+    out = " ".join(capsys.readouterr().out.split())
+    rows = {r["method"]: r for r in read_csv(tmp_path / "stab" / "stability.csv")}
+    penalty, auto = rows["penalty"], rows["auto"]
+    assert penalty["status"] == "converged" and penalty["reference_reached"] == "False"
+    assert penalty["outcome"] == "converged, off the reference by 1.4e-02"
+    assert auto["outcome"] == "converged" and auto["reference_reached"] == "True"
+    assert float(penalty["atol_share"]) == pytest.approx(0.93, abs=0.01)
+    assert "blk-ball-r1e+10: atol = 0.0544 is 93 % of the reference's contact force 0.0585" in out
+    assert "penalty converged, off the reference by 1.4e-02" in out
+
+
+def test_a_stall_in_a_study_names_its_tol(tmp_path):
+    """Penalty at r = 1e6 E/h stalls at round-off above --tol: the failure names --tol.
+
+    It used to say "raise atol ... (or leave it out of the scene: the default
+    follows E)", the scene's key, which a study does not read.
+    """
+    assert main(["study", str(_ball_scene(tmp_path / "ball.toml")), "--methods", "penalty",
+                 "--r", "1e6", "--relative", "--out", str(tmp_path / "study")]) == 0
+    (row,) = read_csv(tmp_path / "study" / "study.csv")
+    assert row["status"] == "cycling"
+    assert row["message"].endswith(f"{RAISE_TOLERANCE} 5e-06 (study's --tol)")
+    assert "[solver]" not in row["message"] and "scene" not in row["message"]

@@ -214,7 +214,8 @@ def _advice(scene: Scene, status: str, overlap: str | None = None, message: str 
     about; first on the list, since no solver setting mends it. ``message``:
     the failed step's; when it already names the one fix (a node inside its
     own self-contact neighbourhood, a support that drives a node into its partner), no
-    solver setting is suggested; when its residual stalled at round-off, only atol.
+    solver setting is suggested; when its residual stalled at round-off, only the
+    scene's [solver] atol (the stall note itself does not say where a tolerance is set).
     ``slots``: a 2D mortar pair whose nodes overlapped
     more target facets than their slots (:func:`~fenics_contact.scene.slot_overflow.
     slot_shortfall`); first on the list, since its weighted gaps jump.
@@ -226,8 +227,11 @@ def _advice(scene: Scene, status: str, overlap: str | None = None, message: str 
     if "the self-contact search never pairs it with" in message or NO_SOLVER_MENDS in message:
         return "."
     if ROUNDOFF_STALL in message:  # no method or step size takes a residual below round-off
-        return (". To try: first a larger [solver] atol, as said above (the residual stalled "
-                "at the round-off of its forces, which no method or step size lowers).")
+        left_out = (" (or leave atol out of the scene: the default follows E)"
+                    if scene.solver.atol_given else "")
+        return (". To try: first a larger [solver] atol, as large as said above"
+                f"{left_out}; the residual stalled at the round-off of its forces, which no "
+                "method or step size lowers.")
     method = scene.solver.method
     tips = []
     if overlap:

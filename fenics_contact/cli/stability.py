@@ -23,7 +23,7 @@ def run_grid_and_write(cases: Sequence, args: argparse.Namespace) -> int:
     from mpi4py import MPI
 
     from fenics_contact.output.io import write_json
-    from fenics_contact.sweeps.stability import ERROR, run_grid
+    from fenics_contact.sweeps.stability import ERROR, loose_tolerances, run_grid
     from fenics_contact.sweeps.sweep_plots import stability_plot
 
     out: Path = args.out
@@ -31,7 +31,7 @@ def run_grid_and_write(cases: Sequence, args: argparse.Namespace) -> int:
 
     def line(rec) -> str:
         return (
-            f"  {rec.case:20s} {rec.method:8s} {rec.status:15s} it {rec.iterations:5d} "
+            f"  {rec.case:20s} {rec.method:8s} {rec.outcome_text():15s} it {rec.iterations:5d} "
             f"steps {rec.steps_completed}/{rec.load_steps}  {rec.wall_s:6.2f} s"
             + ("" if rec.ft_ratio is None else f"  Ft/muN {rec.ft_ratio:.6f}")
             + ("" if rec.reference_reached is None
@@ -39,7 +39,9 @@ def run_grid_and_write(cases: Sequence, args: argparse.Namespace) -> int:
             + (f"  {rec.message}" if rec.message else "")
         )
 
-    records, keep = progress_to_csv(out / "stability.csv", line)
+    records, keep = progress_to_csv(
+        out / "stability.csv", line,
+        "stability's --force-rtol times E h^(d-1); the round-off floor at r is its least")
 
     if rank0:
         print(f"Stability: {len(cases)} cases x {len(args.methods)} methods", flush=True)
@@ -50,6 +52,11 @@ def run_grid_and_write(cases: Sequence, args: argparse.Namespace) -> int:
     )
     write_json(out / "stability.json", [r.to_dict() for r in records])
     if rank0:
+        loose = loose_tolerances(records)
+        if loose:
+            print("\nStopping tolerance a sizeable share of the contact force (a run may stop "
+                  "that far from the answer; \"converged, off the reference\" says where it "
+                  "did):\n  " + "\n  ".join(loose))
         stability_plot(records, out / "stability.png")
         print(f"\nWrote {out}/stability.csv, stability.json, stability.png and cases/*.json")
     crashed = [r for r in records if r.status == ERROR]
@@ -126,7 +133,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="run every method on scenes at extreme r and record each status",
         description="Run methods on each scene at each r (default 1e-8 ... 1e12 E/h); record "
         "each run's status, iterations, forces, F_t/(mu N) and whether it reached the "
-        "reference answer (GNRM at r = 1 E/h); write stability.csv, stability.json, "
+        "reference answer (GNRM at r = 1 E/h; a converged run that misses it by more than "
+        "1e-6 is \"converged, off the reference\", in the picture too, and a tolerance "
+        "above 1 %% of the contact force is named); write stability.csv, stability.json, "
         "stability.png and per-run step records under cases/. The project's own grid of "
         "extremes (E, nu, steps, starts, meshes, friction, pairs) is "
         "benchmarks/robustness/stability_grid.py. Exit code 0, or 1 when a run ended with "
@@ -135,8 +144,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "whatever the scene says), so that every method starts alike, and each Newton "
         "step takes its contact set by the sign rule (--contact-set); the stopping "
         "tolerance is max(--force-rtol E h^(d-1), the round-off floor at r), not the "
-        "scene's atol: iteration counts match `run` with predictor = \"previous\", "
-        "contact_set = \"sign\" and the atol written in stability.json (a scene's "
+        "scene's atol, and no rtol: iteration counts match `run` with predictor = "
+        "\"previous\", contact_set = \"sign\", the atol written in stability.csv and "
+        "rtol = 0 (a scene's default rtol = 1e-10 may stop earlier; a scene's "
         "default contact_set = \"exact\" may converge where a run here does not: "
         "--contact-set exact).",
     )

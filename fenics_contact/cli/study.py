@@ -46,6 +46,7 @@ def study_and_write(subjects: Sequence, args: argparse.Namespace) -> int:
     from fenics_contact.output.io import write_csv, write_json
     from fenics_contact.output.plotting import iterations_against_r, residual_histories
     from fenics_contact.solvers.diagnostics import SolverSettings
+    from fenics_contact.solvers.stepping import name_tolerance
     from fenics_contact.sweeps.study import comparison_table, paper_table, probe_line, run_study
 
     root = MPI.COMM_WORLD.rank == 0  # every process runs the study; one speaks and writes
@@ -59,6 +60,7 @@ def study_and_write(subjects: Sequence, args: argparse.Namespace) -> int:
     settings = SolverSettings(atol=args.tol, max_iterations=args.max_iterations)
 
     def show(rec) -> None:
+        name_tolerance(rec, "study's --tol")
         say(
             f"  {rec.method:8s} r = {rec.r:<10g} {rec.status:15s} iterations {rec.iterations:4d}"
             f"  updates {rec.updates:4d}  {rec.wall_s:6.2f} s",
@@ -131,7 +133,8 @@ def add_study_options(cmd: argparse.ArgumentParser, default_out: Path) -> None:
         help="contact integration: nodal (vertex rule, node-on-facet) or gauss "
         "(default: each contact's own)",
     )
-    cmd.add_argument("--tol", type=float, default=1e-8, help="residual tolerance (1e-8)")
+    cmd.add_argument("--tol", type=float, default=1e-8,
+                     help="absolute residual tolerance (force; default 1e-8; no rtol)")
     cmd.add_argument(
         "--max-iterations", type=int, default=500,
         help="Newton iteration limit per load step (500, as in the paper)",
@@ -150,8 +153,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         "the published ones: benchmarks/research/paper_tables.py (make paper-tables)."
         " Each load step starts from the last converged state (predictor \"previous\", "
         "whatever the scene says), so that every method starts alike, and each Newton "
-        "step takes its contact set by the sign rule, as the paper's GNRM: iteration "
-        "counts match `run` with predictor = \"previous\" and contact_set = \"sign\".",
+        "step takes its contact set by the sign rule, as the paper's GNRM; the stopping "
+        "test is --tol alone (no relative tolerance): iteration counts match `run` with "
+        "predictor = \"previous\", contact_set = \"sign\", atol = --tol and rtol = 0 "
+        "(a scene's default rtol = 1e-10 stops some steps earlier), where no step needs a "
+        "cut-back (a study allows none).",
     )
     study.add_argument("scene", type=Path, help="the scene file (.toml)")
     study.add_argument(

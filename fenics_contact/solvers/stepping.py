@@ -292,6 +292,11 @@ def _settle(strategy: Strategy, t: float) -> None:
         kernel.assemble_residual()
 
 
+#: The stall note's advice; a front end names its own tolerance setting after it
+#: (:func:`name_tolerance`).
+RAISE_TOLERANCE = "raise the absolute tolerance to about"
+
+
 def stall_note(strategy: Strategy, residuals: list[float]) -> str | None:
     """Why the residual of a failed attempt stopped falling, when it is round-off (collective).
 
@@ -299,15 +304,32 @@ def stall_note(strategy: Strategy, residuals: list[float]) -> str | None:
     :meth:`~fenics_contact.model.problem.ContactProblem.residual_roundoff`)
     bounds what any tolerance may demand: a
     residual that sits below it over :data:`STALL_WINDOW` iterations without
-    falling is round-off, and only a larger atol ends the step.
+    falling is round-off, and only a larger atol ends the step. The note
+    does not say where the tolerance is set: each front end says it
+    (:func:`name_tolerance`).
     """
     floor, size, atol = strategy.problem.residual_roundoff()
     level = roundoff_stall(residuals, floor) if floor > 0.0 else None
     if level is None or level <= strategy.settings.atol:  # a strategy's own tighter target
         return None
     return (f"the residual stalls at {level:.2g}, {ROUNDOFF_STALL} {size:.3g} (r g ||A||), "
-            f"above atol = {strategy.settings.atol:g}; raise atol to about {atol:.1g} "
-            "(or leave it out of the scene: the default follows E)")
+            f"above atol = {strategy.settings.atol:g}; {RAISE_TOLERANCE} {atol:.1g}")
+
+
+def name_tolerance(record: RunRecord, setting: str) -> None:
+    """Name ``setting`` (where the tolerance is set) after the stall note's advice in ``record``.
+
+    ``setting``: e.g. "study's --tol". The run's and its steps' messages are
+    amended (once: a second call changes nothing).
+    """
+    advice = re.compile(rf"({re.escape(RAISE_TOLERANCE)} [-+.0-9e]+)(?![-+.0-9e]| \()")
+
+    def named(text: str) -> str:
+        return advice.sub(lambda m: f"{m.group(1)} ({setting})", text)
+
+    record.message = named(record.message)
+    for step in record.steps:
+        step.message = named(step.message)
 
 
 def _failure_message(record: StepRecord, t_try: float, refused: str | None = None,

@@ -21,14 +21,20 @@ import math
 from fenics_contact.solvers.stepping import StepRecord
 
 
+def coulomb_terms(step: StepRecord, mus: dict[str, float]) -> tuple[float, float]:
+    """(sum_c F_t,c, sum_c mu_c N_c) over the contacts named in ``mus`` (name -> mu)."""
+    named = [name for name in mus if name in step.contacts]
+    tangential = sum(step.contacts[name].get("tangential_magnitude",
+                                             step.contacts[name]["tangential_force"])
+                     for name in named)
+    limit = sum(mus[name] * step.contacts[name]["normal_force"] for name in named)
+    return tangential, limit
+
+
 def coulomb_ratio(step: StepRecord, mus: dict[str, float]) -> float:
     """F_t / (mu N) over the contacts named in ``mus`` (name -> mu); NaN without a load."""
-    numbers = [step.contacts[name] for name in mus if name in step.contacts]
-    limit = sum(mus[name] * step.contacts[name]["normal_force"]
-                for name in mus if name in step.contacts)
-    if not numbers or limit <= 0.0:
-        return math.nan
-    return sum(n.get("tangential_magnitude", n["tangential_force"]) for n in numbers) / limit
+    tangential, limit = coulomb_terms(step, mus)
+    return tangential / limit if limit > 0.0 else math.nan
 
 
-__all__ = ["coulomb_ratio"]
+__all__ = ["coulomb_ratio", "coulomb_terms"]

@@ -10,7 +10,10 @@ coefficient, F_t / (mu N) at the last step, and, from :func:`run_grid`, how
 far its answer (N, F_t, rms displacement) is from the reference answer of
 the same scene: GNRM at r = 1 E/h (``auto`` there when GNRM fails). A
 "converged" run whose answer is off by more than :data:`REFERENCE_RTOL` is
-a false convergence.
+a false convergence: its ``outcome`` is :data:`OFF_REFERENCE` (with the
+deviation in tables), drawn in its own colour. Where the stopping tolerance
+is a sizeable share of the reference's contact force (:data:`LOOSE_ATOL_SHARE`;
+at huge r the round-off floor), :func:`loose_tolerances` names it.
 
 The stopping test is the same for every method and meaningful for any E:
 atol = max(force_rtol * E h^(d-1), round-off floor at r)
@@ -41,7 +44,7 @@ from fenics_contact.solvers import STRATEGIES, make_strategy
 from fenics_contact.solvers.diagnostics import SolverSettings, Status
 from fenics_contact.solvers.stepping import RunRecord, StepRecord, solve_load_path, start_record
 from fenics_contact.sweeps.cases import Case, build_case, case_steps
-from fenics_contact.sweeps.coulomb import coulomb_ratio
+from fenics_contact.sweeps.coulomb import coulomb_ratio, coulomb_terms
 
 #: Methods the stability grid runs by default.
 METHODS = tuple(STRATEGIES)
@@ -54,6 +57,10 @@ NONFINITE = "nonfinite"
 REFERENCE_METHODS = ("gnrm", "auto")
 #: Largest relative deviation from the reference answer that counts as reaching it.
 REFERENCE_RTOL = 1e-6
+#: Outcome of a converged run that does not reach the reference within REFERENCE_RTOL.
+OFF_REFERENCE = "converged, off the reference"
+#: Stopping tolerances above this share of the reference's contact force are named.
+LOOSE_ATOL_SHARE = 1e-2
 
 
 @dataclass(frozen=True)
@@ -119,11 +126,33 @@ class CaseRecord(RunRecord):
     #: Largest relative deviation of N, F_t (both relative to the reference N)
     #: and u_rms from the reference answer (None: no reference or not converged).
     reference_deviation: float | None = None
+    #: The reference's normal contact force (force; None: no reference).
+    reference_force: float | None = None
 
     @property
     def tangential_force(self) -> float:
         """Tangential contact force at the last step attempted (force)."""
         return self.steps[-1].tangential_force if self.steps else 0.0
+
+    @property
+    def tangential_magnitude(self) -> float | None:
+        """F_t of ft_ratio: int |t| dA over the frictional contacts at the last step (force).
+
+        None without friction.
+        """
+        if not self.mus or not self.steps:
+            return None
+        return coulomb_terms(self.steps[-1], self.mus)[0]
+
+    @property
+    def mu_normal_force(self) -> float | None:
+        """The mu N of ft_ratio: sum of mu_c N_c over the frictional contacts (force).
+
+        None without friction.
+        """
+        if not self.mus or not self.steps:
+            return None
+        return coulomb_terms(self.steps[-1], self.mus)[1]
 
     @property
     def ft_ratio(self) -> float | None:
@@ -138,6 +167,26 @@ class CaseRecord(RunRecord):
         return None if math.isnan(ratio) else ratio
 
     @property
+    def atol_share(self) -> float | None:
+        """The stopping tolerance over the reference's contact force (None: no reference force)."""
+        if not self.reference_force:
+            return None
+        return self.atol / abs(self.reference_force)
+
+    @property
+    def outcome(self) -> str:
+        """The status, or :data:`OFF_REFERENCE` for a converged run that missed the reference."""
+        if self.converged and self.reference_reached is False:
+            return OFF_REFERENCE
+        return self.status
+
+    def outcome_text(self) -> str:
+        """The outcome in words, with the deviation from the reference when off it."""
+        if self.outcome != OFF_REFERENCE:
+            return self.outcome
+        return f"{OFF_REFERENCE} by {self.reference_deviation:.1e}"
+
+    @property
     def reference_reached(self) -> bool | None:
         """Converged to the reference answer within REFERENCE_RTOL (None: no reference)."""
         if not self.reference:
@@ -150,8 +199,11 @@ class CaseRecord(RunRecord):
         """Flat row; the reference deviation instead of the ``error`` column."""
         d = super().row()
         d.pop("error")
-        d.update(tangential_force=self.tangential_force, ft_ratio=self.ft_ratio,
-                 reference_reached=self.reference_reached)
+        d.update(tangential_force=self.tangential_force,
+                 tangential_magnitude=self.tangential_magnitude,
+                 mu_normal_force=self.mu_normal_force, ft_ratio=self.ft_ratio,
+                 reference_reached=self.reference_reached, outcome=self.outcome_text(),
+                 atol_share=self.atol_share)
         return d
 
 
@@ -299,7 +351,23 @@ def run_grid(
             if ref is not None:
                 record.reference = f"{ref.method} r=1"
                 record.reference_deviation = deviation(record, ref)
+                record.reference_force = ref.contact_force
             records.append(record)
             if progress is not None:
                 progress(record)
     return records
+
+
+def loose_tolerances(records: Sequence[CaseRecord]) -> list[str]:
+    """One line per case whose stopping tolerance exceeds LOOSE_ATOL_SHARE of the contact force.
+
+    Such a tolerance lets a run stop that far from the answer (at huge r the
+    round-off floor sets it): the atol, the reference's force and the share.
+    """
+    lines = {}
+    for rec in records:
+        share = rec.atol_share
+        if share is not None and share > LOOSE_ATOL_SHARE:
+            lines[rec.case] = (f"{rec.case}: atol = {rec.atol:.3g} is {100 * share:.0f} % of the "
+                               f"reference's contact force {abs(rec.reference_force):.3g}")
+    return list(lines.values())

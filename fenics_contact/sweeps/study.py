@@ -174,6 +174,11 @@ def r_key(record: RunRecord, relative: bool = False) -> float:
     return float(f"{record.r_relative if relative else record.r:.6g}")
 
 
+def _r_header(r: float, relative: bool) -> str:
+    """A table's column head: r, relative to E/h when ``relative``."""
+    return f"r = {r:g}" + (" E/h" if relative else "")
+
+
 def paper_table(records: Sequence[RunRecord], limit: int = 500, relative: bool = False) -> str:
     """Markdown table in the paper's layout: methods x r, updates on a second row for NUA.
 
@@ -182,7 +187,7 @@ def paper_table(records: Sequence[RunRecord], limit: int = 500, relative: bool =
     rs = sorted({r_key(rec, relative) for rec in records})
     methods = list(dict.fromkeys(rec.method for rec in records))
     by_key = {(rec.method, r_key(rec, relative)): rec for rec in records}
-    header = "| Method | " + " | ".join(f"r = {r:g}" for r in rs) + " |"
+    header = "| Method | " + " | ".join(_r_header(r, relative) for r in rs) + " |"
     lines = [header, "|---" * (len(rs) + 1) + "|"]
     for m in methods:
         row = [cell(by_key[(m, r)], limit) if (m, r) in by_key else "" for r in rs]
@@ -232,7 +237,8 @@ def comparison_table(
 
     ``relative``: ``r_values`` are relative to E/h (each source's own h).
     """
-    header = "| Method | source | " + " | ".join(f"r = {r:g}" for r in r_values) + " |"
+    header = ("| Method | source | " + " | ".join(_r_header(r, relative) for r in r_values)
+              + " |")
     lines = [header, "|---" * (len(r_values) + 2) + "|"]
     for m in methods:
         for label, source in sources:

@@ -16,12 +16,13 @@ from matplotlib.ticker import NullFormatter
 
 from fenics_contact.output.plotting import save_figure
 from fenics_contact.solvers import PAPER_NAMES
-from fenics_contact.sweeps.stability import CaseRecord
+from fenics_contact.sweeps.stability import OFF_REFERENCE, CaseRecord
 from fenics_contact.sweeps.tradeoff import ERROR_FLOOR, TradeoffRecord
 
-#: Colour of each status in the stability table.
+#: Colour of each outcome in the stability table (a status, or converged off the reference).
 STATUS_COLOURS = {
     "converged": "#7fc97f",
+    OFF_REFERENCE: "#80b1d3",
     "max_iterations": "#fdc086",
     "cycling": "#ffff99",
     "diverged": "#f0027f",
@@ -31,19 +32,37 @@ STATUS_COLOURS = {
 MARKERS = ("o", "s", "^", "D", "v")
 
 
+def _drawn(error: float) -> float:
+    """Where an error sits on a log axis: at ERROR_FLOOR when smaller (0 too)."""
+    return max(error, ERROR_FLOOR)
+
+
+def time_label(recs: Sequence[TradeoffRecord]) -> str:
+    """The time axis' label: a median only where a point was timed more than once."""
+    repeats = max((r.repeats for r in recs if r.status == "converged"), default=1)
+    runs = f", median of {repeats} runs" if repeats > 1 else ""
+    return f"wall time, whole load path (s{runs})"
+
+
 def _panel(ax: plt.Axes, recs: Sequence[TradeoffRecord], field: str, front: str) -> None:
-    """Error against time, one colour a method, one marker a mesh; front joined."""
+    """Error against time, one colour a method, one marker a mesh; front joined.
+
+    Errors below ERROR_FLOOR (0 too) are drawn on it, a dotted line that the
+    legend names.
+    """
     meshes = list(dict.fromkeys(r.mesh for r in recs))
     methods = list(dict.fromkeys(r.method for r in recs))
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    floored = False
     for m, method in enumerate(methods):
         for k, mesh in enumerate(meshes):
             pts = [r for r in recs if r.method == method and r.mesh == mesh
                    and r.status == "converged" and math.isfinite(getattr(r, field))]
             if not pts:
                 continue
+            floored |= any(getattr(r, field) < ERROR_FLOOR for r in pts)
             ax.loglog(
-                [r.wall_s for r in pts], [max(getattr(r, field), ERROR_FLOOR) for r in pts],
+                [r.wall_s for r in pts], [_drawn(getattr(r, field)) for r in pts],
                 MARKERS[k % len(MARKERS)], color=colours[m % len(colours)], ms=5, alpha=0.8,
                 label=f"{PAPER_NAMES.get(method, method)}" if k == 0 else None,
             )
@@ -54,19 +73,22 @@ def _panel(ax: plt.Axes, recs: Sequence[TradeoffRecord], field: str, front: str)
             key=lambda r: r.wall_s,
         )
         if pts:
-            ax.loglog([r.wall_s for r in pts], [max(getattr(r, field), ERROR_FLOOR) for r in pts],
+            ax.loglog([r.wall_s for r in pts], [_drawn(getattr(r, field)) for r in pts],
                       "-", color="k", lw=1, zorder=0)
-            ax.loglog([r.wall_s for r in pts], [max(getattr(r, field), ERROR_FLOOR) for r in pts],
+            ax.loglog([r.wall_s for r in pts], [_drawn(getattr(r, field)) for r in pts],
                       "o", mfc="none", mec="k", ms=10, mew=1.2)
     for k, mesh in enumerate(meshes):
         ax.plot([], [], MARKERS[k % len(MARKERS)], color="grey", label=f"mesh {mesh}")
     ax.plot([], [], "o", mfc="none", mec="k", ms=10, label="Pareto front")
+    if floored:
+        ax.axhline(ERROR_FLOOR, color="grey", ls=":", lw=1, zorder=0,
+                   label=f"error < {ERROR_FLOOR:g} (0 too), drawn at {ERROR_FLOOR:g}")
     ax.xaxis.set_minor_formatter(NullFormatter())  # decade labels only: no overlap
-    ax.set_xlabel("wall time, whole load path (s, median)")
+    ax.set_xlabel(time_label(recs))
     ax.legend(fontsize=7, ncol=2)
 
 
-def tradeoff_plot(records: Sequence[TradeoffRecord], path: Path) -> None:
+def tradeoff_figure(records: Sequence[TradeoffRecord]) -> plt.Figure:
     """One panel per case (displacement error vs time), plus Hertz peak error vs time.
 
     A case is a scene, or a friction scene at one Coulomb coefficient.
@@ -83,11 +105,25 @@ def tradeoff_plot(records: Sequence[TradeoffRecord], path: Path) -> None:
                 else "peak-pressure error vs Hertz (rel.)")
         ax.set_ylabel(what)
         ax.set_title(f"{case}: {'per mesh' if front == 'pareto_u' else 'all meshes'}", fontsize=9)
-    save_figure(fig, path)
+    return fig
+
+
+def tradeoff_plot(records: Sequence[TradeoffRecord], path: Path) -> None:
+    """Write :func:`tradeoff_figure` to ``path``."""
+    save_figure(tradeoff_figure(records), path)
 
 
 def stability_plot(records: Sequence[CaseRecord], path: Path) -> None:
-    """Case x method table coloured by status, with the Newton iterations written in."""
+    """Write :func:`stability_figure` to ``path``."""
+    save_figure(stability_figure(records), path)
+
+
+def stability_figure(records: Sequence[CaseRecord]) -> plt.Figure:
+    """Case x method table coloured by outcome, with the Newton iterations written in.
+
+    A converged run that missed the reference has its own colour, and its
+    deviation written in.
+    """
     cases = list(dict.fromkeys(r.case for r in records))
     methods = list(dict.fromkeys(r.method for r in records))
     statuses = list(STATUS_COLOURS)
@@ -95,10 +131,13 @@ def stability_plot(records: Sequence[CaseRecord], path: Path) -> None:
     text: dict[tuple[int, int], str] = {}
     for rec in records:
         i, j = cases.index(rec.case), methods.index(rec.method)
-        grid[i, j] = statuses.index(rec.status) if rec.status in statuses else len(statuses) - 1
+        outcome = rec.outcome
+        grid[i, j] = statuses.index(outcome) if outcome in statuses else len(statuses) - 1
         note = str(rec.iterations)
-        if rec.status != "converged":
-            note += f" {rec.status.replace('max_iterations', 'max it')}"
+        if outcome == OFF_REFERENCE:
+            note += f" off {rec.reference_deviation:.0e}"
+        elif outcome != "converged":
+            note += f" {outcome.replace('max_iterations', 'max it')}"
         text[(i, j)] = note
     fig, ax = plt.subplots(figsize=(2.0 + 1.45 * len(methods), 0.9 + 0.26 * len(cases)))
     cmap = ListedColormap([STATUS_COLOURS[s] for s in statuses])
@@ -111,6 +150,6 @@ def stability_plot(records: Sequence[CaseRecord], path: Path) -> None:
     handles = [plt.Rectangle((0, 0), 1, 1, color=STATUS_COLOURS[s]) for s in statuses]
     ax.legend(handles, statuses, fontsize=7, ncol=3, loc="upper center",
               bbox_to_anchor=(0.5, -0.01), frameon=False)
-    ax.set_title("status per case and method (Newton iterations, all load steps)", fontsize=9,
+    ax.set_title("outcome per case and method (Newton iterations, all load steps)", fontsize=9,
                  pad=22)
-    save_figure(fig, path)
+    return fig

@@ -18,8 +18,13 @@ largest tangential complementarity residual |P(lam_t + r_t dg_t) - lam_t|
 (force; not defined for the penalty method, which has no multiplier).
 
 Stopping test for every method: atol = max(1e-10 E h^(d-1), round-off
-floor at r) (:func:`fenics_contact.model.scaling.scaled_atol`). The reference is
-GNRM at r = 1 E/h with 1e-13 E h^(d-1).
+floor at r) (:func:`fenics_contact.model.scaling.scaled_atol`), no rtol,
+written per run as ``atol``. The reference is GNRM at r = 1 E/h with
+1e-13 E h^(d-1).
+
+Picks ("fastest", "most accurate", the Pareto fronts) leave out the
+reference's own run (:func:`on_reference_path`) unless only it converged;
+points whose u error is at round-off (:data:`ROUNDOFF_ERROR`) tie.
 """
 
 from __future__ import annotations
@@ -52,8 +57,16 @@ from fenics_contact.sweeps.study import relative_l2_error
 
 #: r values relative to E/h of the full sweep: 1e-4 ... 1e8, a decade apart.
 FULL_R = tuple(10.0**e for e in range(-4, 9))
-#: Displacement errors below this are round-off (relative L2); plots and fronts clip to it.
+#: Smallest displacement error a plot draws (relative L2): smaller ones, 0 too, sit on it.
 ERROR_FLOOR = 1e-15
+#: Displacement errors at or below this reach the reference to round-off: such points tie.
+ROUNDOFF_ERROR = 10.0 * ERROR_FLOOR
+#: r of the reference (relative to E/h) and its tolerance relative to E h^(d-1).
+REFERENCE_R = 1.0
+REFERENCE_FORCE_RTOL = 1e-13
+#: Methods whose run at the reference's r follows its path: GNRM, and ``auto``
+#: (plain GNRM at its working r).
+REFERENCE_PATH_METHODS = ("gnrm", "auto")
 METHODS = tuple(STRATEGIES)
 @dataclass(frozen=True)
 class TradeoffCase:
@@ -84,11 +97,15 @@ class TradeoffRecord(RunRecord):
     |F_t / (mu N) - 1| over the reference's fully sliding steps,
     ``stick_slip`` the largest slip increment at a sticking node (length),
     ``t_residual`` the largest tangential complementarity residual (force).
+    ``r_working``: the r the solves worked at, relative to E/h (``auto``'s
+    clamped r; the user's r otherwise); ``atol`` the stopping tolerance (force).
     """
 
     scene: str = ""
     mesh: str = ""
     repeats: int = 1
+    r_working: float = math.nan
+    atol: float = math.nan
     p0_error: float = math.nan
     mu: float = math.nan
     ft_error: float = math.nan
@@ -132,8 +149,9 @@ def _fully_sliding(step: StepRecord) -> bool:
 
 def reference_solution(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> Reference | None:
     """Tight GNRM solution on the scene's mesh; None if it fails."""
-    problem = build_case(scene, 1.0, True, None, comm)
-    settings = SolverSettings(atol=scaled_atol(problem, 1e-13), max_iterations=100)
+    problem = build_case(scene, REFERENCE_R, True, None, comm)
+    settings = SolverSettings(atol=scaled_atol(problem, REFERENCE_FORCE_RTOL),
+                              max_iterations=100)
     path = solve_load_path(make_strategy("gnrm", problem, settings), case_steps(scene),
                            max_cutbacks=4)
     if not path.converged:
@@ -219,7 +237,7 @@ def run_point(
         strategy = make_strategy(method, problem, settings, contact_set=contact_set)
         record = TradeoffRecord(
             **vars(start_record(strategy)), scene=case.scene, mesh=case.mesh,
-            mu=_mu(case.case),
+            mu=_mu(case.case), atol=settings.atol,
         )
         meter = None
         if not math.isnan(record.mu):
@@ -228,6 +246,7 @@ def run_point(
                         on_step=meter)
         if meter is not None:
             meter.score(record, reference)
+        record.r_working = strategy.working_r() / problem.stiffness_scale
         times.append(record.wall_s)
         if not record.converged:
             break
@@ -284,40 +303,47 @@ def _front(points: Sequence[TradeoffRecord], error: Callable[[TradeoffRecord], f
     return front
 
 
+def on_reference_path(record: TradeoffRecord) -> bool:
+    """Whether a point is the reference's own run, whose error measures nothing.
+
+    GNRM iterates at the reference's r: GNRM at r = 1 E/h, or ``auto`` working
+    at r = 1 E/h (plain GNRM there, whatever r it was given).
+    """
+    return (record.method in REFERENCE_PATH_METHODS
+            and math.isclose(record.r_working, REFERENCE_R, rel_tol=1e-9))
+
+
+def candidates(points: Sequence[TradeoffRecord]) -> list[TradeoffRecord]:
+    """The points a pick chooses from: all but the reference's own run, unless only it is left."""
+    return [r for r in points if not on_reference_path(r)] or list(points)
+
+
+def _u_score(record: TradeoffRecord) -> float:
+    """The u error a front compares: errors at round-off tie."""
+    return max(record.u_error, ROUNDOFF_ERROR)
+
+
 def mark_pareto(records: Sequence[TradeoffRecord]) -> None:
-    """Mark the Pareto fronts among converged records.
+    """Mark the Pareto fronts among converged records (:func:`candidates` of each group).
 
     ``pareto_u``: displacement error against time, per case (scene, and mu
-    with friction) and mesh (the solver's trade on one discretisation).
-    ``pareto_p0``: Hertz peak-pressure error against time over all meshes of
-    the scene (the whole trade).
+    with friction) and mesh (the solver's trade on one discretisation);
+    errors at round-off tie. ``pareto_p0``: Hertz peak-pressure error against
+    time over all meshes of the scene (the whole trade).
     """
     ok = [r for r in records if r.status == Status.CONVERGED]
     for key in {(r.case, r.mesh) for r in ok}:
-        points = [r for r in ok if (r.case, r.mesh) == key and math.isfinite(r.u_error)]
-        for i in _front(points, lambda r: max(r.u_error, ERROR_FLOOR)):
+        points = candidates([r for r in ok if (r.case, r.mesh) == key
+                             and math.isfinite(r.u_error)])
+        for i in _front(points, _u_score):
             points[i].pareto_u = True
     for case in {r.case for r in ok}:
-        points = [r for r in ok if r.case == case and math.isfinite(r.p0_error)]
+        points = candidates([r for r in ok if r.case == case and math.isfinite(r.p0_error)])
         for i in _front(points, lambda r: r.p0_error):
             points[i].pareto_p0 = True
 
 
-def _is_reference_point(record: TradeoffRecord) -> bool:
-    """Whether a point's error measures nothing: it is the reference, to round-off.
-
-    GNRM at r = 1 E/h (the reference's own path), or any point within
-    10 ERROR_FLOOR of it (``auto`` at an r it rescales to its working r = 1
-    E/h with the vertex rule takes the reference's iterates: 0 or 1e-15).
-    """
-    return (record.method == "gnrm" and record.r_relative == 1.0) or \
-        record.u_error <= 10.0 * ERROR_FLOOR
-
-
-def _reference_note(record: TradeoffRecord) -> str:
-    if record.method == "gnrm" and record.r_relative == 1.0:
-        return " (the reference's own path)"
-    return " (the reference's answer to round-off)"
+_OWN_PATH = " (the reference's own path)"
 
 
 def _fmt(x: float) -> str:
@@ -330,26 +356,54 @@ def _worst(values: Sequence[float]) -> float:
     return max(finite) if finite else math.nan
 
 
+def most_accurate(good: Sequence[TradeoffRecord]) -> str:
+    """The most accurate of converged points: 'r, error', or the r that tie at round-off.
+
+    The reference's own run is left out unless only it converged (then
+    marked); where several points reach the reference to round-off
+    (u error <= :data:`ROUNDOFF_ERROR`) none of them is picked: all are named.
+    """
+    points = candidates(good)
+    if not points:
+        return "-"
+    best = min(points, key=lambda r: (error_of(r), r.wall_s))
+    tied = sorted((r for r in points if r.u_error <= ROUNDOFF_ERROR),
+                  key=lambda r: r.r_relative)
+    if len(tied) > 1 and best in tied:
+        text = (f"r = {', '.join(f'{r.r_relative:g}' for r in tied)} reach the reference to "
+                f"round-off (u error <= {max(r.u_error for r in tied):.1e})")
+        if math.isfinite(best.p0_error):
+            text += f", error {_fmt(best.p0_error)}"
+    else:
+        text = f"{best.r_relative:g}, {_fmt(error_of(best))}"
+    return text + (_OWN_PATH if on_reference_path(best) else "")
+
+
+def fastest(good: Sequence[TradeoffRecord]) -> str:
+    """The fastest of converged points (:func:`candidates`): r, time, iterations, error."""
+    fast = min(candidates(good), key=lambda r: r.wall_s)
+    return (f"{fast.r_relative:g}, {fast.wall_s:.3f}, {fast.iterations}, "
+            f"{_fmt(error_of(fast))}" + (_OWN_PATH if on_reference_path(fast) else ""))
+
+
 def _summary(recs: Sequence[TradeoffRecord]) -> tuple[list[TradeoffRecord], str, str, str]:
     """Converged records, their r span, the fastest point and the r that did not converge."""
     good = [r for r in recs if r.status == Status.CONVERGED]
     bad = [f"{r.r_relative:g} ({r.status})" for r in recs if r.status != Status.CONVERGED]
     if not good:
         return good, "none", "-", ", ".join(bad) or "-"
-    fast = min(good, key=lambda r: r.wall_s)
     span = f"{min(r.r_relative for r in good):g} - {max(r.r_relative for r in good):g}"
-    fastest = (f"{fast.r_relative:g}, {fast.wall_s:.3f}, {fast.iterations}, "
-               f"{_fmt(error_of(fast))}")
-    return good, span, fastest, ", ".join(bad) or "-"
+    return good, span, fastest(good), ", ".join(bad) or "-"
 
 
 def markdown_table(records: Sequence[TradeoffRecord]) -> str:
-    """Per scene and mesh, per method: the best converged point and where it fails.
+    """Per scene and mesh, per method: the best converged points and where it fails.
 
-    Columns: fastest converged r, its time and error; the r at which the
-    method is most accurate (not GNRM at r = 1 E/h, the reference's own path,
-    unless it is the only one); and the r values (relative) that did not
-    converge. Friction cases get their own table (:func:`friction_table`).
+    Columns: fastest converged r, its time and error; the most accurate
+    point (:func:`most_accurate`); and the r values (relative) that did not
+    converge. Neither pick is the reference's own run (GNRM iterates at
+    r = 1 E/h) unless only it converged, and then it is marked. Friction
+    cases get their own table (:func:`friction_table`).
     """
     lines = [
         "| scene | mesh | method | converged r (E/h) | fastest: r, time s, iterations, error | "
@@ -360,18 +414,10 @@ def markdown_table(records: Sequence[TradeoffRecord]) -> str:
     keys = list(dict.fromkeys((r.scene, r.mesh, r.method) for r in plain))
     for scene, mesh, method in keys:
         recs = [r for r in plain if (r.scene, r.mesh, r.method) == (scene, mesh, method)]
-        good, span, fastest, bad = _summary(recs)
-        accurate = "-"
-        # a point on the reference's own path (GNRM at r = 1 E/h, or the same iterates)
-        # has an error that measures nothing
-        measured = [r for r in good if not _is_reference_point(r)] or good
-        if measured:
-            best = min(measured, key=lambda r: (max(error_of(r), ERROR_FLOOR), r.wall_s))
-            accurate = f"{best.r_relative:g}, {_fmt(error_of(best))}"
-            if _is_reference_point(best):
-                accurate += _reference_note(best)
+        good, span, fast, bad = _summary(recs)
+        accurate = most_accurate(good) if good else "-"
         lines.append(
-            f"| {scene} | {mesh} | {PAPER_NAMES.get(method, method)} | {span} | {fastest} | "
+            f"| {scene} | {mesh} | {PAPER_NAMES.get(method, method)} | {span} | {fast} | "
             f"{accurate} | {bad} |"
         )
     friction = [r for r in records if not math.isnan(r.mu)]
@@ -397,13 +443,13 @@ def friction_table(records: Sequence[TradeoffRecord]) -> str:
     for scene, mesh, mu, method in keys:
         key = (scene, mesh, mu, method)
         recs = [r for r in records if (r.scene, r.mesh, r.mu, r.method) == key]
-        good, span, fastest, bad = _summary(recs)
+        good, span, fast, bad = _summary(recs)
         worst = ", ".join(
             _fmt(_worst([getattr(r, f) for r in good]))
             for f in ("u_error", "ft_error", "stick_slip", "t_residual")
         ) if good else "-"
         lines.append(
             f"| {scene} | {mesh} | {mu:g} | {PAPER_NAMES.get(method, method)} | {span} | "
-            f"{fastest} | {worst} | {bad} |"
+            f"{fast} | {worst} | {bad} |"
         )
     return "\n".join(lines)
