@@ -433,3 +433,28 @@ def test_picture_titles_name_the_step_shown_and_a_failed_one():
     assert picture_title("s", RunRecord("diverged", [stuck])) == (
         "s: step 1 diverged at load factor 0.375; shown: the state it stopped in, load "
         "factor 0.25, contact force 1.5 (not written)")
+
+
+def test_a_second_run_into_a_folder_being_written_is_refused(tmp_path, capsys):
+    """A --resume started while the first run still wrote into the folder found its
+    checkpoint "damaged or unreadable". A folder that a live process holds is refused
+    before any work (exit 2, naming the process); a lock left by a killed run is taken
+    over, and a finished run leaves none."""
+    import os
+    import subprocess
+
+    from fenics_contact.output.folders import LOCK
+
+    scene = SCENES / "block_on_block.toml"
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / LOCK).write_text(f"{os.getppid()} {__import__('socket').gethostname()}")
+    assert main(["run", str(scene), "--out", str(out), "--no-pictures"]) == 2
+    err = capsys.readouterr().err
+    assert f"another run (process {os.getppid()}) is writing to {out}" in err
+    assert not (out / "summary.json").exists()
+    gone = subprocess.Popen(["true"])
+    gone.wait()
+    (out / LOCK).write_text(f"{gone.pid} {__import__('socket').gethostname()}")
+    assert main(["run", str(scene), "--out", str(out), "--no-pictures"]) == 0
+    assert (out / "summary.json").is_file() and not (out / LOCK).exists()

@@ -79,10 +79,11 @@ def _run(args: argparse.Namespace) -> int:
         option = "--resume" if args.resume is not None else "--out"
         prepare_output_folder(out, MPI.COMM_WORLD, option)  # a bad folder ends here, before meshing
         finished = [_checkpoint_step(out) if args.resume is not None else 0]
-        from fenics_contact.output.folders import OutputWriteError
+        from fenics_contact.output.folders import OutputWriteError, run_lock
 
         try:
-            return _solve(args, scene, out, stop, finished)
+            with run_lock(out, MPI.COMM_WORLD, option):
+                return _solve(args, scene, out, stop, finished)
         except StopRequested as exc:
             _stopped(exc, args, out, scene.solver.steps, finished[0])
             return exc.exit_code
