@@ -235,6 +235,11 @@ def _advice(scene: Scene, status: str, overlap: str | None = None, message: str 
                 "method or step size lowers.")
     method = scene.solver.method
     tips = []
+    if "svk" in {b.law for b in scene.bodies} | {scene.law}:
+        tips.append('if a body is compressed by more than about 40 %, law = "neo-hookean": '
+                    "the St. Venant-Kirchhoff law softens under compression (its uniaxial "
+                    "stress peaks at the stretch 1/sqrt(3)), and past that an equilibrium "
+                    "may not exist or not be unique, however small the steps")
     if overlap:
         tips.append(f"first the start: {overlap}; place the obstacle so that the gap at "
                     "load 0 is >= 0")
