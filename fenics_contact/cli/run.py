@@ -235,11 +235,6 @@ def _advice(scene: Scene, status: str, overlap: str | None = None, message: str 
                 "method or step size lowers.")
     method = scene.solver.method
     tips = []
-    if "svk" in {b.law for b in scene.bodies} | {scene.law}:
-        tips.append('if a body is compressed by more than about 40 %, law = "neo-hookean": '
-                    "the St. Venant-Kirchhoff law softens under compression (its uniaxial "
-                    "stress peaks at the stretch 1/sqrt(3)), and past that an equilibrium "
-                    "may not exist or not be unique, however small the steps")
     if overlap:
         tips.append(f"first the start: {overlap}; place the obstacle so that the gap at "
                     "load 0 is >= 0")
@@ -252,6 +247,11 @@ def _advice(scene: Scene, status: str, overlap: str | None = None, message: str 
     if method != "auto":
         tips.append('method = "auto" (Newton on both unknowns; it lowers its working r '
                     "and line-searches where plain Newton cycles)")
+    if status != "max_iterations" and "svk" in {b.law for b in scene.bodies} | {scene.law}:
+        tips.append('if a body is compressed by more than about 40 %, law = "neo-hookean": '
+                    "the St. Venant-Kirchhoff law softens under compression (its uniaxial "
+                    "stress peaks at the stretch 1/sqrt(3)), and past that an equilibrium "
+                    "may not exist or not be unique, however small the steps")
     tips.append("more [solver] steps or max_cutbacks (smaller increments near the failure)")
     return ". To try: " + "; ".join(tips) + "."
 
