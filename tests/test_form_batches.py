@@ -56,3 +56,75 @@ def test_a_single_form_is_compiled_as_usual():
     residuals, _ = _blocks()
     compiled = form_together(residuals[0])
     assert isinstance(compiled, fem.Form)
+
+
+def _count_compilations(monkeypatch) -> list:
+    """Patch FFCx's code generation in this process to record each module it makes."""
+    import ffcx.compiler
+
+    made: list = []
+    original = ffcx.compiler.compile_ufl_objects
+
+    def counting(objects, *args, **kwargs):
+        made.append(len(objects))
+        return original(objects, *args, **kwargs)
+
+    monkeypatch.setattr(ffcx.compiler, "compile_ufl_objects", counting)
+    return made
+
+
+def _assembled(J) -> np.ndarray:
+    A = fem_petsc.assemble_matrix(J, kind="mpi")
+    A.assemble()
+    return A.convert("dense").getDenseArray()
+
+
+def test_a_large_batch_is_split_and_compiled_by_child_processes(tmp_path, monkeypatch):
+    """Forked children fill the cache; this process reads the modules and assembles the same."""
+    from fenics_contact.model import form_batches
+
+    residuals, jacobian = _blocks()
+    reference = _assembled(fem.form(jacobian))
+    monkeypatch.setattr(form_batches, "SPLIT_ABOVE", 0)  # split this small batch
+    monkeypatch.setenv("FENICS_CONTACT_COMPILE_JOBS", "2")
+    flat = [*residuals, *(b for row in jacobian for b in row)]
+    groups = form_batches.split_batch(flat)
+    assert sorted(i for g in groups for i in g) == list(range(len(flat)))
+    assert len(groups) == min(form_batches.GROUPS, len(flat))
+    assert form_batches.split_batch(flat) == groups  # the same modules every time
+    made = _count_compilations(monkeypatch)  # after the fork, only this process counts
+    F, J = form_together([residuals, jacobian], jit_options={"cache_dir": str(tmp_path)})
+    assert made == []  # every module came from a child, through the cache
+    assert len(list(tmp_path.glob("*.c.cached"))) == len(groups)
+    modules = {id(f.module) for f in [*F, *(b for row in J for b in row)]}
+    assert len(modules) == len(groups)
+    assert np.allclose(_assembled(J), reference, rtol=1e-14, atol=1e-14)
+
+
+def test_a_failed_child_leaves_its_module_to_this_process(tmp_path, monkeypatch):
+    from fenics_contact.model import form_batches
+
+    def failing(*args):
+        raise RuntimeError("no compiler")
+
+    residuals, jacobian = _blocks()
+    monkeypatch.setattr(form_batches, "SPLIT_ABOVE", 0)
+    monkeypatch.setenv("FENICS_CONTACT_COMPILE_JOBS", "2")
+    monkeypatch.setattr(form_batches, "_compile_in_child", failing)
+    made = _count_compilations(monkeypatch)
+    _, J = form_together([residuals, jacobian], jit_options={"cache_dir": str(tmp_path)})
+    assert len(made) == min(form_batches.GROUPS, 6)  # each module compiled here
+    assert np.allclose(_assembled(J), _assembled(fem.form(jacobian)), rtol=1e-14, atol=1e-14)
+
+
+def test_compile_jobs_from_the_environment(monkeypatch):
+    from fenics_contact.model.form_batches import MAX_JOBS, compile_jobs
+
+    monkeypatch.delenv("FENICS_CONTACT_COMPILE_JOBS", raising=False)
+    assert 1 <= compile_jobs() <= MAX_JOBS
+    monkeypatch.setenv("FENICS_CONTACT_COMPILE_JOBS", "3")
+    assert compile_jobs() == 3
+    for bad in ("0", "two"):
+        monkeypatch.setenv("FENICS_CONTACT_COMPILE_JOBS", bad)
+        with pytest.raises(ValueError, match=r"FENICS_CONTACT_COMPILE_JOBS.*positive integer"):
+            compile_jobs()

@@ -41,7 +41,11 @@ from dolfinx.fem import petsc as fem_petsc
 
 from mpi4py import MPI
 
-from fenics_contact.model.form_batches import CONTACT_CFLAGS
+from fenics_contact.model.form_batches import (
+    CONTACT_CFLAGS,
+    WAIT_S,
+    compile_in_background,
+)
 from fenics_contact.model.segments3d import REFERENCE, STRIKER_EDGES, Segments
 
 #: Columns of a corner's provenance row: kind (3), striker corner (3), target
@@ -54,9 +58,17 @@ WIDTH = 22
 #: 170 s at -O1 on it (2-core machine); -O1 assembles it 2.3 times faster, but it
 #: is assembled only on the segments of engaged nodes (docs/two_bodies.md).
 HESSIAN_OPT = "-O0"
+#: Rows of the segment's (6, 3) vertex data: the striker triangle's and the target's.
+HALVES = {"s": (0, 1, 2), "t": (3, 4, 5)}
 #: A pair of triangles that keeps every formula finite in unused cells.
 _DUMMY = np.vstack([np.column_stack([REFERENCE, np.zeros(3)]),
                     np.column_stack([REFERENCE[::-1], np.ones(3)])])
+
+
+def _rows(direction: ufl.core.expr.Expr, rows: tuple[int, ...]) -> ufl.core.expr.Expr:
+    """``direction`` (6, 3) with every row outside ``rows`` zero (a derivative's direction)."""
+    return ufl.as_matrix([[direction[r, i] if r in rows else 0.0 for i in range(3)]
+                          for r in range(6)])
 
 
 def provenance_weights(segments: Segments) -> np.ndarray:
@@ -115,36 +127,78 @@ class SegmentForms:
         dx = ufl.dx(metadata={"quadrature_degree": 2})  # N_j g is quadratic on a segment
         self.gap_form = ufl.dot(weight * gap * jac, v) * dx
         self.weight_form = ufl.dot(shape * jac, v) * dx
-        #: Corner weights of the weighted gaps (a) and covered areas (b) in :attr:`hessian_form`.
+        #: Corner weights of the weighted gaps (a) and covered areas (b) in :attr:`hessian_parts`.
         self.a = fem.Function(self.V3, name="gap_weights")
         self.b = fem.Function(self.V3, name="area_weights")
         dw, dW = ufl.TestFunction(self.W6), ufl.TrialFunction(self.W6)
         weighted = (ufl.dot(self.a, weight) * gap + ufl.dot(self.b, shape)) * jac * dx
         self.gap_tangent_form = ufl.derivative(self.gap_form, self.w, dW)
         self.weight_tangent_form = ufl.derivative(self.weight_form, self.w, dW)
-        self.hessian_form = ufl.derivative(ufl.derivative(weighted, self.w, dw), self.w, dW)
-        self._compiled: dict[str, fem.Form] | None = None
+        #: The Hessian in blocks of the striker (s) and target (t) vertex rows:
+        #: ss, st and tt; H = ss + st + st^T + tt (the mixed derivatives commute).
+        #: Three smaller kernels instead of one, compiled at the same time.
+        self.hessian_parts = {
+            f"hessian_{a}{b}": ufl.derivative(
+                ufl.derivative(weighted, self.w, _rows(dw, HALVES[a])), self.w,
+                _rows(dW, HALVES[b]))
+            for a, b in ("ss", "st", "tt")}
+        self._compiled: dict[str, fem.Form] = {}
         self._matrices: dict = {}
+        self._start_compiling()
         self.fill(np.zeros((0, 6, 3)), np.zeros((0, 3, WIDTH)))
 
+    #: The forms each compiled as its own module; the Hessian's parts (the largest) are
+    #: needed last.
+    NAMES = ("gap", "weight", "gap_tangent", "weight_tangent")
+    HESSIAN = ("hessian_ss", "hessian_st", "hessian_tt")
+
+    @staticmethod
+    def jit_options(name: str) -> dict:
+        """C flags of a form's module: the large Hessian kernel at HESSIAN_OPT."""
+        flags = [HESSIAN_OPT, "-g0"] if name.startswith("hessian") else CONTACT_CFLAGS
+        # another segment mesh's background process may be compiling it: wait for it
+        return {"cffi_extra_compile_args": flags, "timeout": WAIT_S}
+
+    def _ufl_form(self, name: str) -> ufl.Form:
+        return self.hessian_parts[name] if name in self.hessian_parts else getattr(
+            self, f"{name}_form")
+
+    def _start_compiling(self) -> None:
+        """Compile the forms in background processes (one machine, empty cache).
+
+        The Hessian's parts, the longest, start first; :meth:`compiled` waits for
+        the others only, :meth:`assemble_matrix` for the Hessian when it is
+        first assembled, so that its compilation overlaps the rest of the build.
+        """
+        comm = self.mesh.comm
+        self._pending = {
+            group: compile_in_background(
+                [([self._ufl_form(name)], self.jit_options(name)) for name in names], comm)
+            for group, names in (("hessian", self.HESSIAN), ("others", self.NAMES))}
+
+    def _form(self, name: str) -> fem.Form:
+        pending = self._pending.get("hessian" if name.startswith("hessian") else "others")
+        if pending is not None:
+            pending.wait()
+        if name not in self._compiled:
+            self._compiled[name] = fem.form(self._ufl_form(name),
+                                            jit_options=self.jit_options(name))
+        return self._compiled[name]
+
     def compiled(self) -> dict[str, fem.Form]:
-        """The five forms compiled (once; the large Hessian kernel at HESSIAN_OPT)."""
-        if self._compiled is None:
-            self._compiled = {
-                name: fem.form(getattr(self, f"{name}_form"), jit_options={
-                    "cffi_extra_compile_args": [HESSIAN_OPT, "-g0"] if name == "hessian"
-                    else CONTACT_CFLAGS})
-                for name in ("gap", "weight", "gap_tangent", "weight_tangent", "hessian")
-            }
-        return self._compiled
+        """The four forms other than the Hessian, compiled (once)."""
+        return {name: self._form(name) for name in self.NAMES}
 
     def assemble_matrix(self, name: str) -> sp.csr_matrix:
         """A compiled bilinear form (``gap_tangent``, ``weight_tangent``, ``hessian``) as CSR.
 
-        The PETSc matrix is made once per form (its pattern is block diagonal, one
-        block per cell) and refilled.
+        The PETSc matrix of each form is made once (its pattern is block
+        diagonal, one block per cell) and refilled. ``hessian`` sums its parts.
         """
-        form = self.compiled()[name]
+        if name == "hessian":
+            ss, st, tt = (self.assemble_matrix(part) for part in self.HESSIAN)
+            return (ss + st + st.T + tt).tocsr()
+        form = self._form(name)
         matrix = self._matrices.get(name)
         if matrix is None:
             matrix = self._matrices[name] = fem_petsc.create_matrix(form)
@@ -249,7 +303,7 @@ class SegmentForms:
         self.theta.x.array[:] = full[self.cell_rows]
 
     def set_corner_weights(self, a: np.ndarray, b: np.ndarray) -> None:
-        """Load the (count, 3) corner weights of :attr:`hessian_form` (zero in unused cells)."""
+        """Load the (count, 3) corner weights of :attr:`hessian_parts` (zero in unused cells)."""
         for f, values in ((self.a, a), (self.b, b)):
             full = np.zeros((self.capacity, 3))
             full[: self.count] = values
