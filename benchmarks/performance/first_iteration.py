@@ -16,9 +16,13 @@ dictionary): the first start before and after, measured side by side.
 added to every pair that has none (a copy of the scene file, beside it):
 the frictional 3D two-body start that users meet.
 
+``--before TREE`` adds, per scene, a cold run of another checkout's code
+(``git worktree add TREE COMMIT``) on the same scene file: a change's first
+start before and after, side by side.
+
 Run: ``python benchmarks/performance/first_iteration.py [--repeats 2]
 [--scenes two_hemispheres_3d,block_on_block_3d] [--friction 0.3] [--scan-too]
-[--out results/bench]``.
+[--before TREE] [--out results/bench]``.
 """
 
 from __future__ import annotations
@@ -67,16 +71,17 @@ print(json.dumps({{"import_s": imported, "first_iteration_s": time.perf_counter(
 """
 
 
-def once(scene: Path, cache: str, scan: bool = False) -> dict:
+def once(scene: Path, cache: str, scan: bool = False, code: Path = ROOT) -> dict:
     """One run in a fresh process with ``XDG_CACHE_HOME=cache``.
 
     ``scan``: with FFCx's own node lookup in its value numbering (a scan of
     the whole graph per lookup) instead of the dictionary the package
-    installs (:mod:`fenics_contact.form_compiler`).
+    installs (:mod:`fenics_contact.form_compiler`). ``code``: the source
+    tree whose ``fenics_contact`` runs (another checkout, for a before/after).
     """
-    env = dict(os.environ, XDG_CACHE_HOME=cache)
+    env = dict(os.environ, XDG_CACHE_HOME=cache, PYTHONPATH=str(code))
     out = subprocess.run([sys.executable, "-c", CHILD.format(scene=str(scene), scan=scan)],
-                         env=env,
+                         env=env, cwd=code,
                          capture_output=True, text=True, check=False)
     if out.returncode != 0:
         return {"first_iteration_s": float("nan"), "status": "failed: "
@@ -114,6 +119,9 @@ def main() -> None:
                         help="add Coulomb friction MU to every pair (3D two-body with friction)")
     parser.add_argument("--scan-too", action="store_true",
                         help="also a cold run with FFCx's own node lookup, side by side")
+    parser.add_argument("--before", type=Path, default=None, metavar="TREE",
+                        help="also a cold run of each scene with the fenics_contact of another "
+                             "checkout (git worktree add TREE COMMIT), side by side")
     args = parser.parse_args()
     names = (args.scenes.split(",") if args.scenes
              else sorted(p.stem for p in (ROOT / "scenes").glob("*.toml")))
@@ -136,12 +144,21 @@ def main() -> None:
                 scan = once(scene, cache, scan=True)
             runs[-1]["cold_scan_s"] = round(scan["first_iteration_s"], 1)
             runs[-1]["cold_ratio"] = round(cold["first_iteration_s"] / scan["first_iteration_s"], 2)
+        if args.before is not None:
+            with tempfile.TemporaryDirectory() as cache:
+                before = once(scene, cache, code=args.before.resolve())
+            runs[-1]["cold_before_s"] = round(before["first_iteration_s"], 1)
+            runs[-1]["cold_ratio"] = round(cold["first_iteration_s"]
+                                           / before["first_iteration_s"], 2)
         print(runs[-1], flush=True)
     header = ["scene", "cold s", "warm s (median)", "import s", "status"]
     columns = ["scene", "cold_s", "warm_s", "import_s", "status"]
     if args.scan_too:
         header += ["cold s, FFCx's scan", "cold ratio"]
         columns += ["cold_scan_s", "cold_ratio"]
+    if args.before is not None:
+        header += [f"cold s, {args.before.name}", "cold ratio"]
+        columns += ["cold_before_s", "cold_ratio"]
     table = harness.report("first_iteration", runs, header, columns, args.out)
     print(table)
 

@@ -209,7 +209,7 @@ class BackgroundCompilation:
 
 def compile_in_background(requests: Sequence[tuple[list[ufl.Form], dict | None]],
                           comm) -> BackgroundCompilation | None:
-    """Start compiling each (forms, jit_options) of ``requests`` as its own module.
+    """Start compiling each (forms, jit_options) of ``requests`` as its own module, all at once.
 
     Returns the handle to :meth:`~BackgroundCompilation.wait` on before the forms
     are compiled by ``dolfinx.fem.form`` (they then come from the cache), or
@@ -223,7 +223,8 @@ def compile_in_background(requests: Sequence[tuple[list[ufl.Form], dict | None]]
         jit = dolfinx.jit.get_options(jit_options)
         jit["timeout"] = max(int(jit.get("timeout", 10)), WAIT_S)
         modules.append((list(forms), options, jit))
-    return BackgroundCompilation(modules)
+    # all at once: this process goes on meanwhile and nothing would start the queued ones
+    return BackgroundCompilation(modules, jobs=len(modules))
 
 
 def _compile_groups(forms: list[ufl.Form], options: dict, jit: dict, parallel: bool) -> list:

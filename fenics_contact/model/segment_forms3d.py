@@ -151,6 +151,8 @@ class SegmentForms:
     #: needed last.
     NAMES = ("gap", "weight", "gap_tangent", "weight_tangent")
     HESSIAN = ("hessian_ss", "hessian_st", "hessian_tt")
+    #: Set by the process's first segment mesh, which starts the background compilation.
+    _compiling_started = False
 
     @staticmethod
     def jit_options(name: str) -> dict:
@@ -166,20 +168,26 @@ class SegmentForms:
     def _start_compiling(self) -> None:
         """Compile the forms in background processes (one machine, empty cache).
 
-        The Hessian's parts, the longest, start first; :meth:`compiled` waits for
-        the others only, :meth:`assemble_matrix` for the Hessian when it is
-        first assembled, so that its compilation overlaps the rest of the build.
+        Only the process's first segment mesh does: a form's module does not
+        depend on the mesh, and a later mesh waits for the same modules.
+
+        The Hessian's three parts, the longest to compile and the last needed,
+        are compiled by child processes while this one compiles the other
+        forms and goes on building the problem; :meth:`assemble_matrix` waits
+        for them when the Hessian is first assembled.
         """
-        comm = self.mesh.comm
-        self._pending = {
-            group: compile_in_background(
-                [([self._ufl_form(name)], self.jit_options(name)) for name in names], comm)
-            for group, names in (("hessian", self.HESSIAN), ("others", self.NAMES))}
+        self._pending = None
+        if SegmentForms._compiling_started:  # the same modules as the first segment mesh's
+            return
+        SegmentForms._compiling_started = True
+        self._pending = compile_in_background(
+            [([self.hessian_parts[name]], self.jit_options(name)) for name in self.HESSIAN],
+            self.mesh.comm)
 
     def _form(self, name: str) -> fem.Form:
-        pending = self._pending.get("hessian" if name.startswith("hessian") else "others")
-        if pending is not None:
-            pending.wait()
+        if self._pending is not None and name in self.HESSIAN:
+            self._pending.wait()
+            self._pending = None
         if name not in self._compiled:
             self._compiled[name] = fem.form(self._ufl_form(name),
                                             jit_options=self.jit_options(name))
