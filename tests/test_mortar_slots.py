@@ -4,10 +4,11 @@ A node's weighted gap integrates over its two striker facets cut at the
 target facets that overlap them; the compiled forms hold a fixed number of
 those per node. With too few (a coarse striker over a fine target) the gap
 leaves part of the support out and jumps as the kept facets change: an
-ironing run with a target twice as fine as the shipped one (h = 0.02 at
+ironing run with a target three times as fine as its striker (h = 0.02 at
 the indenter against the block's 0.06) cycled at load step 36 of 50 with
 GNRM and `auto` alike; with the slots chosen from the facet sizes (8) every
-step converges (`benchmarks/validation/ironing_mortar.py --h-indenter 0.02`).
+step converges (`benchmarks/validation/ironing_mortar.py --h-indenter 0.02
+--h-block 0.06 --steps 50`).
 """
 
 from __future__ import annotations
