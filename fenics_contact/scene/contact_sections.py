@@ -20,6 +20,7 @@ from fenics_contact.scene.spec import (
     ObstacleSpec,
     PairSpec,
     SceneError,
+    default_discretisation,
 )
 
 
@@ -220,24 +221,30 @@ def _slots(reader: _Reader, dimension: int) -> int | None:
     """[[pair]] slots: target facets a 2D mortar striker node may see; None: from the meshes."""
     if "slots" not in reader.table:
         return None
-    if reader.table.get("discretisation") != "mortar" or dimension != 2:
+    discretisation = reader.table.get("discretisation", default_discretisation(
+        reader.flag("self_contact", False)))
+    if discretisation != "mortar" or dimension != 2:
         raise reader.fail("slots", "is the number of target facets a striker node of a 2D "
-                          'mortar pair may see: it needs discretisation = "mortar" in a 2D '
-                          "scene; remove it here.")
+                          "mortar pair may see: it needs a mortar pair in a 2D scene; "
+                          "remove it here.")
     return reader.integer("slots", 4, minimum=2, maximum=32,
                           why="each slot adds to the compiled forms; refine the striker "
                           "surface instead.")
 
 
 def _discretisation(reader: _Reader, dim: int, two_surfaces: bool) -> str:
-    """[[pair]] discretisation: "node-to-segment" (default) or "mortar".
+    """[[pair]] discretisation: "mortar" or "node-to-segment".
 
+    The default is mortar for a pair between bodies (exact on non-matching
+    meshes) and node-to-segment for self-contact (the key self_contact = true).
     A mortar pair joins two disjoint surfaces: of two bodies, or two surfaces
     of one body (self_contact = true with a target other than the striker).
     """
-    value = reader.table.get("discretisation", "node-to-segment")
+    value = reader.table.get("discretisation", default_discretisation(
+        reader.flag("self_contact", False)))
     if value not in ("node-to-segment", "mortar"):
-        raise reader.fail("discretisation", 'choose "node-to-segment" (the default) or "mortar".')
+        raise reader.fail("discretisation", 'choose "mortar" (the default between bodies) or '
+                          '"node-to-segment" (the default for self-contact).')
     if value == "mortar" and reader.flag("self_contact", False):
         if not two_surfaces:
             raise reader.fail(

@@ -225,10 +225,12 @@ KEY_DOCS: dict[str, dict[str, KeyDoc]] = {
         "neighbourhood": KeyDoc("number > 0", "Self-contact: radius along the surface, in "
                                 "facet sizes, that a node does not search.", "facet sizes",
                                 field="PairSpec.neighbourhood"),
-        "discretisation": KeyDoc('"node-to-segment" | "mortar"', "Node-to-segment, or mortar "
-                                 "(exact on non-matching meshes; 2D and 3D, with or without "
-                                 "friction; self-contact of two surfaces of one body too).",
-                                 field="PairSpec.discretisation"),
+        "discretisation": KeyDoc('"mortar" | "node-to-segment"', "Mortar (exact on "
+                                 "non-matching meshes; 2D and 3D, with or without friction; "
+                                 "self-contact of two surfaces of one body too), or "
+                                 "node-to-segment (compiles faster; one surface against "
+                                 "itself).", "",
+                                 "mortar; node-to-segment with self_contact = true"),
         "interference_until": KeyDoc("number in (0, 1]", "An interference fit: the surfaces "
                                      "start inside each other (meshed before assembly) and "
                                      "the overlap is resolved in proportion to the load factor "

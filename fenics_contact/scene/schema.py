@@ -62,8 +62,9 @@ Deformable bodies in one mesh replace [material] and [contact] by::
                  defaults to striker; one [[body]] is then enough; so it is with
                  [[obstacle]] blocks and no pair), neighbourhood
                  (facet sizes along the surface a node does not search; default 3)
-                 discretisation = "node-to-segment" (default) | "mortar"
-                 (exact on non-matching meshes; 2D and 3D, with or without mu)
+                 discretisation = "mortar" (the default between bodies: exact on
+                 non-matching meshes; 2D and 3D, with or without mu) |
+                 "node-to-segment" (the default for self-contact)
     [[obstacle]] as above, its tag on the facets of one body
 
 In every scene a [[dirichlet]] may give path = [[t, ux, uy], ...] (a

@@ -89,12 +89,27 @@ class PairSpec:
     self_contact: bool = False
     #: Radius of each node's excluded neighbourhood along the surface (facet sizes).
     neighbourhood: float = 3.0
-    #: "node-to-segment" (one pass, the default) or "mortar" (segment to segment, 2D and 3D).
-    discretisation: str = "node-to-segment"
+    #: "mortar" (segment to segment, 2D and 3D) or "node-to-segment" (one pass); None:
+    #: mortar between bodies, node-to-segment for self-contact (:func:`default_discretisation`).
+    discretisation: str | None = None
     #: Load factor by which a starting overlap (an interference fit) is resolved; None: at once.
     interference_until: float | None = None
     #: 2D mortar: target facets a striker node may see; None: chosen from the facet sizes.
     slots: int | None = None
+
+    def __post_init__(self) -> None:
+        if self.discretisation is None:
+            object.__setattr__(self, "discretisation",
+                               default_discretisation(self.self_contact))
+
+
+def default_discretisation(self_contact: bool) -> str:
+    """A [[pair]]'s discretisation when none is given.
+
+    Mortar between bodies (exact on non-matching meshes, smooth pressures);
+    node-to-segment for self-contact (one surface against itself needs it).
+    """
+    return "node-to-segment" if self_contact else "mortar"
 
 
 @dataclass(frozen=True)
