@@ -12,6 +12,7 @@ pressure read -1.0989 against the declared pair's -2.1978.
 
 from __future__ import annotations
 
+import dataclasses
 import tomllib
 from pathlib import Path
 
@@ -28,12 +29,18 @@ SCENES = Path(__file__).parent.parent / "scenes"
 
 
 def automatic(name: str, **pairing) -> tuple:
-    """The shipped scene and its variant with [pairing] automatic = true instead of [[pair]]."""
+    """The shipped scene and its variant with [pairing] automatic = true instead of [[pair]].
+
+    The declared pairs are made node-to-segment, as the automatic ones are.
+    """
     path = SCENES / name
     data = tomllib.loads(path.read_text())
     data.pop("pair")
     data["pairing"] = {"automatic": True, **pairing}
-    return load_scene(path), scene_from_data(data, path)
+    hand = load_scene(path)
+    hand = dataclasses.replace(hand, pairs=tuple(
+        dataclasses.replace(p, discretisation="node-to-segment") for p in hand.pairs))
+    return hand, scene_from_data(data, path)
 
 
 def pressures(problem, name: str, force: bool = False) -> dict[tuple, float]:
