@@ -7,10 +7,12 @@ ones 9.4 -> 7.1 s, the Hertz cylinder 2.3 -> 1.8 s (docs/benchmarks.md).
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
 import ufl
-from dolfinx import fem, mesh
+from dolfinx import default_scalar_type, fem, mesh
 from dolfinx.fem import petsc as fem_petsc
 
 from mpi4py import MPI
@@ -128,3 +130,42 @@ def test_compile_jobs_from_the_environment(monkeypatch):
         monkeypatch.setenv("FENICS_CONTACT_COMPILE_JOBS", bad)
         with pytest.raises(ValueError, match=r"FENICS_CONTACT_COMPILE_JOBS.*positive integer"):
             compile_jobs()
+
+
+def _dead_pid() -> int:
+    import subprocess
+    import sys
+
+    child = subprocess.Popen([sys.executable, "-c", "pass"])
+    child.wait()
+    return child.pid
+
+
+@pytest.mark.parametrize("single", [False, True])
+def test_a_lock_left_by_a_killed_compilation_is_cleared(tmp_path, monkeypatch, single):
+    """A run killed while compiling (Ctrl-C in a first start) left the module's empty C
+    file, and the next run waited for it until its timeout, then failed. A lock whose
+    owner no longer runs is removed and the module compiled; a live owner's is kept."""
+    import dolfinx.jit
+    import ffcx
+
+    from fenics_contact.model import form_batches
+
+    monkeypatch.setattr(form_batches, "WAIT_S", 3)
+    monkeypatch.setenv("FENICS_CONTACT_COMPILE_JOBS", "1")
+    residuals, jacobian = _blocks()
+    forms = [residuals[0]] if single else [*residuals, *(b for row in jacobian for b in row)]
+    jit = {"cache_dir": str(tmp_path), "timeout": 3}
+    c_file = form_batches._module_c_file(
+        forms, ffcx.get_options({"scalar_type": default_scalar_type}),
+        dolfinx.jit.get_options(jit))
+    c_file.parent.mkdir(parents=True, exist_ok=True)
+    c_file.write_text("")
+    owner = c_file.with_suffix(".c.owner")
+    owner.write_text(str(os.getpid()))  # alive: kept
+    assert not form_batches.clear_stale_lock(c_file) and c_file.exists()
+    owner.write_text(str(_dead_pid()))
+    compiled = form_together(forms[0] if single else [residuals, jacobian], jit_options=jit)
+    assert c_file.with_suffix(".c.cached").exists() and not owner.exists()
+    if single:
+        assert isinstance(compiled, fem.Form)

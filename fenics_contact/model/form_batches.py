@@ -145,9 +145,75 @@ def _module_c_file(forms: list[ufl.Form], options: dict, jit: dict) -> Path | No
     return Path(jit["cache_dir"]) / f"{name}.c"
 
 
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process
+        return True
+    return True
+
+
+def _owner_file(c_file: Path) -> Path:
+    return c_file.with_suffix(".c.owner")
+
+
+def clear_stale_lock(c_file: Path | None) -> bool:
+    """Remove the cache's lock on a module whose compiling process is gone.
+
+    FFCx marks a module being compiled by its (at first empty) C file and
+    waits for the ``.c.cached`` file that ends the compilation; a process
+    killed meanwhile (Ctrl-C during a first run, a killed job) leaves the C
+    file behind, and every later run waited for it until its timeout and
+    failed. The package writes the compiling process's id beside the C file
+    (``.c.owner``); a lock whose owner no longer runs is removed. Returns
+    True when one was.
+    """
+    if c_file is None or not c_file.exists() or c_file.with_suffix(".c.cached").exists():
+        return False
+    owner = _owner_file(c_file)
+    try:
+        pid = int(owner.read_text().strip())
+    except (OSError, ValueError):
+        return False  # not ours (or not written yet): leave it to FFCx's wait
+    if _alive(pid):
+        return False
+    c_file.unlink(missing_ok=True)
+    owner.unlink(missing_ok=True)
+    return True
+
+
+def _claim(c_file: Path | None) -> None:
+    """Before compiling: clear a stale lock, then name this process as the owner."""
+    if c_file is None:
+        return
+    clear_stale_lock(c_file)
+    if not c_file.exists():
+        try:
+            _owner_file(c_file).parent.mkdir(parents=True, exist_ok=True)
+            _owner_file(c_file).write_text(str(os.getpid()))
+        except OSError:
+            pass
+
+
+def _release(c_file: Path | None) -> None:
+    if c_file is not None and c_file.with_suffix(".c.cached").exists():
+        _owner_file(c_file).unlink(missing_ok=True)
+
+
+def _compile_module(forms: list[ufl.Form], options: dict, jit: dict) -> tuple:
+    """FFCx's compile_forms, with the module's lock owned (see :func:`clear_stale_lock`)."""
+    c_file = _module_c_file(forms, options, jit)
+    _claim(c_file)
+    out = ffcx.codegeneration.jit.compile_forms(forms, options=options, **jit)
+    _release(c_file)
+    return out
+
+
 def _compile_in_child(forms: list[ufl.Form], options: dict, jit: dict) -> None:
     """Body of a forked child: fill the cache entry of ``forms``, nothing else."""
-    ffcx.codegeneration.jit.compile_forms(forms, options=options, **jit)
+    _compile_module(forms, options, jit)
 
 
 def _can_fork() -> bool:
@@ -170,6 +236,7 @@ class BackgroundCompilation:
         self._queue: list[tuple[list[ufl.Form], dict, dict, Path]] = []
         for forms, options, jit in modules:
             c_file = _module_c_file(forms, options, jit)
+            clear_stale_lock(c_file)
             if c_file is not None and not c_file.exists():
                 self._queue.append((forms, options, jit, c_file))
         self._jobs = max(1, jobs or compile_jobs())
@@ -203,6 +270,7 @@ class BackgroundCompilation:
                 child.join()
                 if child.exitcode != 0 and not c_file.with_suffix(".c.cached").exists():
                     c_file.unlink(missing_ok=True)  # left to the caller
+                    _owner_file(c_file).unlink(missing_ok=True)
             self._running = still
             self._fill()
 
@@ -239,8 +307,7 @@ def _compile_groups(forms: list[ufl.Form], options: dict, jit: dict, parallel: b
         BackgroundCompilation([([forms[i] for i in g], options, jit) for g in groups]).wait()
     out: list = [None] * len(forms)
     for group in groups:
-        compiled, module, code = ffcx.codegeneration.jit.compile_forms(
-            [forms[i] for i in group], options=options, **jit)
+        compiled, module, code = _compile_module([forms[i] for i in group], options, jit)
         for i, c in zip(group, compiled, strict=True):
             out[i] = (c, module, code)
     return out
@@ -278,7 +345,14 @@ def form_together(forms: Any, *, entity_maps=None, jit_options: dict | None = No
     """
     flat = list(_flat(forms))
     if len(flat) < 2:
-        return fem.form(forms, entity_maps=entity_maps, jit_options=jit_options)
+        c_file = None
+        if flat and flat[0].ufl_domain().ufl_cargo().comm.rank == 0:
+            c_file = _module_c_file(flat, ffcx.get_options({"scalar_type": default_scalar_type}),
+                                    dolfinx.jit.get_options(jit_options))
+            _claim(c_file)
+        compiled = fem.form(forms, entity_maps=entity_maps, jit_options=jit_options)
+        _release(c_file)
+        return compiled
     comm = flat[0].ufl_domain().ufl_cargo().comm
     options = ffcx.get_options({"scalar_type": default_scalar_type})
     jit = dolfinx.jit.get_options(jit_options)

@@ -45,6 +45,7 @@ from fenics_contact.model.form_batches import (
     CONTACT_CFLAGS,
     WAIT_S,
     compile_in_background,
+    form_together,
 )
 from fenics_contact.model.segments3d import REFERENCE, STRIKER_EDGES, Segments
 
@@ -189,8 +190,8 @@ class SegmentForms:
             self._pending.wait()
             self._pending = None
         if name not in self._compiled:
-            self._compiled[name] = fem.form(self._ufl_form(name),
-                                            jit_options=self.jit_options(name))
+            self._compiled[name] = form_together(self._ufl_form(name),
+                                                 jit_options=self.jit_options(name))
         return self._compiled[name]
 
     def compiled(self) -> dict[str, fem.Form]:
