@@ -162,7 +162,9 @@ def test_mortar_tangent_finite_differences() -> None:
 
 # -- scenes -------------------------------------------------------------------------------------
 def _scene_text(edit) -> str:
+    """The node-to-segment patch-test scene without its discretisation key, edited."""
     text = (ROOT / "scenes" / "block_on_block_node_to_segment.toml").read_text()
+    text = text.replace('discretisation = "node-to-segment"\n', "")
     return edit(text).replace("../meshes", str(ROOT / "meshes"))
 
 
@@ -177,6 +179,22 @@ def test_mortar_scene_key_errors(tmp_path) -> None:
             load_scene(path)
         assert message in str(err.value)
         assert "node-to-segment" in str(err.value)
+
+
+def test_a_pair_between_bodies_is_mortar_unless_it_says_otherwise(tmp_path) -> None:
+    """The default discretisation: mortar between bodies (slots allowed without the key),
+    node-to-segment for self-contact and when named."""
+    from fenics_contact.scene.schema import load_scene
+    from fenics_contact.scene.spec import PairSpec
+
+    for edit, expected in (("", "mortar"), ("\nslots = 6", "mortar"),
+                           ('\ndiscretisation = "node-to-segment"', "node-to-segment")):
+        path = tmp_path / "default.toml"
+        path.write_text(_scene_text(lambda s, e=edit: s.replace(
+            'target = "target_face"', f'target = "target_face"{e}')))
+        assert load_scene(path).pairs[0].discretisation == expected, edit
+    assert PairSpec("p", "a", "b").discretisation == "mortar"
+    assert PairSpec("p", "a", "a", self_contact=True).discretisation == "node-to-segment"
 
 
 def test_mortar_scene_runs_end_to_end(tmp_path) -> None:

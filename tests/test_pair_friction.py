@@ -255,7 +255,7 @@ def test_hemispheres_slide_in_3d():
         "body": [{"name": "upper", "tag": "striker", **law},
                  {"name": "lower", "tag": "target", **law}],
         "pair": [{"name": "pair", "striker": "striker_cap", "target": "target_cap",
-                  "r": 1.0, "mu": MU}],
+                  "r": 1.0, "mu": MU, "discretisation": "node-to-segment"}],
         "dirichlet": [{"tag": "top", "path": [[0.0, 0.0, 0.0, 0.0], [0.5, 0.0, 0.0, -0.02],
                                               [1.0, 0.0, 0.02, -0.02]]},
                       {"tag": "bottom", "value": [0.0, 0.0, 0.0]}],

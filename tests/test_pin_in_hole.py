@@ -89,7 +89,8 @@ steps = 10
 pictures = false
 """
 
-DECLARED = '[[pair]]\nstriker = "pin_surface"\ntarget = "hole"\n'
+DECLARED = ('[[pair]]\nstriker = "pin_surface"\ntarget = "hole"\n'
+            'discretisation = "node-to-segment"\n')  # as the automatic pair
 AUTOMATIC = "[pairing]\nautomatic = true\n"
 
 

@@ -655,8 +655,8 @@ def test_bodies_starting_deep_inside_each_other_are_refused(tmp_path):
 def test_mortar_bodies_starting_deep_inside_each_other_are_refused(tmp_path):
     """The weighted gaps of a mortar pair measure the overlap (0.2 = 1.6 h)."""
     path = _overlapping(tmp_path, 0.2)
-    text = path.read_text().replace('target = "target_face"',
-                                    'target = "target_face"\ndiscretisation = "mortar"')
+    text = path.read_text().replace('discretisation = "node-to-segment"',
+                                    'discretisation = "mortar"')
     path.write_text(text)
     with pytest.raises(SceneError, match=r"\[\[pair\]\] '[^']+': the bodies '[^']+' and "
                        r"'[^']+' start 0.2 inside each other near "
@@ -672,7 +672,7 @@ def test_mortar_bodies_overlapping_beyond_the_segment_search_are_refused(tmp_pat
     """
     path = _overlapping(tmp_path, 0.3)
     path.write_text(path.read_text().replace(
-        'target = "target_face"', 'target = "target_face"\ndiscretisation = "mortar"'))
+        'discretisation = "node-to-segment"', 'discretisation = "mortar"'))
     with pytest.raises(SceneError, match=r"the bodies 'upper' and 'lower' start 0.3 inside each "
                        r"other near \([0-9.]+, 0.2\), more than the striker facet size "
                        r"h = 0.125"):

@@ -20,9 +20,11 @@ from fenics_contact.runner import run_scene
 from fenics_contact.scene.schema import load_scene, scene_from_data
 
 SCENE = Path(__file__).parent.parent / "scenes" / "three_blocks_3d.toml"
-HAND = [
-    {"name": "top-on-middle", "striker": "top_underside", "target": "middle_topside"},
-    {"name": "middle-on-bottom", "striker": "middle_underside", "target": "bottom_topside"},
+HAND = [  # node-to-segment, as the automatic pairs are
+    {"name": "top-on-middle", "striker": "top_underside", "target": "middle_topside",
+     "discretisation": "node-to-segment"},
+    {"name": "middle-on-bottom", "striker": "middle_underside", "target": "bottom_topside",
+     "discretisation": "node-to-segment"},
 ]
 
 

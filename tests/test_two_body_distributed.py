@@ -90,7 +90,7 @@ BLOCKS_FORCE = 4.996737475946084
 @pytest.mark.mpi
 def test_striker_on_both_ranks_keeps_part_of_the_target(tmp_path) -> None:
     text = (ROOT / "scenes" / "block_on_block_3d.toml").read_text()
-    for old, new in (('discretisation = "mortar"', "r = 1.0"),
+    for old, new in (('discretisation = "mortar"', 'discretisation = "node-to-segment"'),
                      ("h_upper = 0.125, h_lower = 0.17",
                       "width = 1.0, height = 0.2, h_upper = 0.08, h_lower = 0.11"),
                      ('"../meshes/', f'"{ROOT / "meshes"}/')):

@@ -40,7 +40,7 @@ def mortar_scene(directory: Path, h: float, ratio: float, steps: int) -> Path:
                      ("target_ratio = 1.0", f"target_ratio = {ratio!r}"),
                      ("steps = 12", f"steps = {steps}"),
                      ("[0.25, 0.0, -0.03]", f"[{1 / 3!r}, 0.0, -0.03]"),
-                     ("\nmu = 0.3", '\nmu = 0.3\ndiscretisation = "mortar"')):
+                     ('discretisation = "node-to-segment"', 'discretisation = "mortar"')):
         if old not in text:
             raise RuntimeError(f"{SCENE.name} changed: {old!r} not found")
         text = text.replace(old, new)

@@ -225,8 +225,8 @@ def _slots(reader: _Reader, dimension: int) -> int | None:
         reader.flag("self_contact", False)))
     if discretisation != "mortar" or dimension != 2:
         raise reader.fail("slots", "is the number of target facets a striker node of a 2D "
-                          "mortar pair may see: it needs a mortar pair in a 2D scene; "
-                          "remove it here.")
+                          'mortar pair may see: it needs discretisation = "mortar" (the '
+                          "default between bodies) in a 2D scene; remove it here.")
     return reader.integer("slots", 4, minimum=2, maximum=32,
                           why="each slot adds to the compiled forms; refine the striker "
                           "surface instead.")
