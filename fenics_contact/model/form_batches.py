@@ -70,7 +70,7 @@ MAX_JOBS = 4
 #: Estimated size (:func:`compile_size`) of a batch below which it stays one module,
 #: where more modules' fixed costs would eat the gain: the twelve Jacobian and residual
 #: blocks of the 2D mortar kernel estimate 400 000 (37 s to compile in one process),
-#: its four nodal forms 5 600 (1.1 s).
+#: a batch of four other forms of the same scene 5 600 (1.1 s).
 SPLIT_ABOVE = 50_000
 
 
