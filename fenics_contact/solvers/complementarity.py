@@ -171,10 +171,10 @@ class ExactContactSet:
         counts = self.comm.allgather(pos.size)
         self._step = _Candidates(
             positions=pos,
-            weights=np.concatenate(self.comm.allgather(np.concatenate(weights))),
+            weights=_joined(self.comm, np.concatenate(weights)),
             owner=np.repeat(np.arange(len(counts)), counts),
             local=np.concatenate([np.arange(k) for k in counts]).astype(np.int64),
-            forced=np.concatenate(self.comm.allgather(np.concatenate(forced))),
+            forced=_joined(self.comm, np.concatenate(forced)),
         )
         return changed
 
@@ -199,7 +199,7 @@ class ExactContactSet:
     def _closest(self, gaps: list[np.ndarray], nears: list[np.ndarray]) -> list[np.ndarray]:
         """At most :data:`MAX_FORCED` open candidates over the ranks: those of smallest gap."""
         local = np.concatenate([g[n] for g, n in zip(gaps, nears, strict=True)])
-        every = np.sort(np.concatenate(self.comm.allgather(local)))
+        every = np.sort(_joined(self.comm, local))
         if every.size <= MAX_FORCED:
             return nears
         limit = every[MAX_FORCED - 1]
@@ -220,7 +220,7 @@ class ExactContactSet:
     # -- after the solve -----------------------------------------------------------
     def _gather(self, local: np.ndarray) -> np.ndarray:
         """Rows of a local array at every candidate (global order)."""
-        return np.concatenate(self.comm.allgather(local[self._step.positions]))
+        return _joined(self.comm, local[self._step.positions])
 
     def _columns(self, wanted: list[int]) -> np.ndarray:
         """z_j = J^-1 e_j for the wanted candidates: the local rows (n_local x k).
@@ -289,6 +289,13 @@ class ExactContactSet:
             if value > 0.0 and step.owner[j] == self.comm.rank:
                 p = step.positions[step.local[j]]
                 arr[p] = x[p]  # lam = x - dx = 0: the node leaves the step open
+
+
+def _joined(comm: MPI.Comm, local: np.ndarray) -> np.ndarray:
+    """Every rank's ``local`` rows joined in rank order (a copy; serial: without MPI)."""
+    if comm.size == 1:
+        return np.array(local, copy=True)
+    return np.concatenate(comm.allgather(local))
 
 
 def _solve_lcp(F0: np.ndarray, G: np.ndarray, tol: float) -> np.ndarray:
