@@ -4,6 +4,8 @@
 [--only hertz2d,cost,predict,compile,first,mortar,hertz3d,ladder,mpi,speedup,inexact,
 twobody]``.
 The ladder's large sizes take minutes each; ``--quick`` stops at 1e5 DOFs.
+Ends with ``benchmarks/targets.py``: every target, its figure before and
+now from the records, and whether it is met (``results/bench/targets.md``).
 Serial and 2-rank runs of a size are run one after the other, on a machine
 that others may be using: compare them side by side, not across days.
 """
@@ -113,6 +115,7 @@ def main() -> None:
         call(([MPIEXEC, "-n", str(ranks)] if ranks > 1 else []) + cmd)
     if parts & {"ladder", "mpi", "speedup", "inexact"}:
         call([PYTHON, str(HERE / "performance" / "ladder3d.py"), "--table"])
+    call([PYTHON, str(HERE / "targets.py")])  # the targets, before and now, from the records
 
 
 if __name__ == "__main__":
