@@ -186,12 +186,35 @@ def test_the_records_figures_and_verdicts(bench: Path) -> None:
 def test_a_missed_threshold_says_no(bench: Path) -> None:
     _write(bench, "cost_of_contact", _cost(1.31, 1.2))
     _write(bench, "two_body_3d_iterative_np2",
-           _two_body(1.2, 2.1, (0.005, 0.07), newton=(22, 20)))  # 1.62x, 21 against 22
+           _two_body(1.2, 1.7, (0.005, 0.07), newton=(22, 20)))  # 2.00x, but 21 against 22
     rows = _rows(bench)
     assert _row(rows, "cost of contact")["met"] == "no"
     assert _row(rows, "the same on 2 ranks")["met"] == "yes"
     speed = _row(rows, "the same: 2 ranks")
-    assert speed["met"] == "no" and speed["now"] == "1.62x, Newton 21 and 22, 20 and 20"
+    assert speed["met"] == "no" and speed["now"] == "2.00x, Newton 21 and 22, 20 and 20"
+    _write(bench, "two_body_3d_iterative_np2", _two_body(1.2, 2.1, (0.005, 0.07)))
+    speed = _row(_rows(bench), "the same: 2 ranks")
+    assert speed["met"] == "no" and speed["now"] == "1.62x, Newton 21 and 21, 20 and 20"
+
+
+def test_slow_starts_and_auto_over_its_bound_say_no(bench: Path) -> None:
+    _write(bench, "friction/first_iteration",
+           _first({"two_hemispheres_3d_node_to_segment_mu0.3": 19.6}, {}))  # 0.503x
+    _write(bench, "first_iteration", _first({}, {name: 1.0 for name in SHIPPED}
+                                            | {"o_ring": 3.01}))
+    auto = _auto({"hertz": [16] * 5 + [21] * 6})  # 1.31x
+    rows = _rows(bench)
+    assert _row(rows, "first start of the frictional")["now"] == "19.6 s (0.50x)"
+    assert _row(rows, "first start of the frictional")["met"] == "no"
+    assert _row(rows, "warm start")["met"] == "no" and "3.01 s (o_ring" in _row(
+        rows, "warm start")["now"]
+    _write(bench, "auto_r_range", auto)
+    assert _row(_rows(bench), "auto at r")["met"] == "no"
+    auto = _auto({"hertz": [16] * 11})
+    auto["scenes"]["hertz"]["status"]["1e+12"] = "diverged"
+    _write(bench, "auto_r_range", auto)
+    row = _row(_rows(bench), "auto at r")
+    assert row["met"] == "no" and row["now"].endswith("not every run converged")
 
 
 def test_missing_records_name_the_command_that_writes_them(tmp_path: Path) -> None:
