@@ -1,7 +1,7 @@
 """Run every benchmark in sequence (one process per case) and gather the tables.
 
 ``python benchmarks/run_all.py [--quick]
-[--only hertz2d,cost,predict,compile,first,mortar,hertz3d,ladder,mpi,speedup,inexact,
+[--only hertz2d,cost,predict,auto,compile,first,mortar,hertz3d,ladder,mpi,speedup,inexact,
 twobody]``.
 The ladder's large sizes take minutes each; ``--quick`` stops at 1e5 DOFs.
 Ends with ``benchmarks/targets.py``: every target, its figure before and
@@ -63,8 +63,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--only",
-                        default="hertz2d,cost,predict,compile,first,mortar,hertz3d,ladder,mpi,"
-                                "speedup,inexact,twobody")
+                        default="hertz2d,cost,predict,auto,compile,first,mortar,hertz3d,ladder,"
+                                "mpi,speedup,inexact,twobody")
     args = parser.parse_args()
     parts = set(args.only.split(","))
     limit = 1e5 if args.quick else 1e6
@@ -75,6 +75,8 @@ def main() -> None:
     if "predict" in parts:
         call([PYTHON, str(HERE / "performance" / "active_set_prediction.py")])
         call([PYTHON, str(HERE / "performance" / "exact_contact_set.py")])
+    if "auto" in parts:
+        call([PYTHON, str(HERE / "performance" / "auto_r_range.py")])
     if "compile" in parts:
         call([PYTHON, str(HERE / "performance" / "compile_cost.py")])
     if "first" in parts:
