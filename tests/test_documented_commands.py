@@ -43,6 +43,8 @@ COMMANDS: dict[str, str | tuple[str, str]] = {
     "python benchmarks/run_all.py --quick": "{python} benchmarks/run_all.py --help",
     "python benchmarks/validation/hertz2d.py": "{python} benchmarks/validation/hertz2d.py --help",
     "python benchmarks/targets.py": "{python} benchmarks/targets.py --bench {out}",
+    "python benchmarks/performance/auto_r_range.py":
+        "{python} benchmarks/performance/auto_r_range.py --help",
     "python benchmarks/performance/cost_of_contact.py":
         "{python} benchmarks/performance/cost_of_contact.py --help",
     "python benchmarks/validation/hertz3d.py": "{python} benchmarks/validation/hertz3d.py --help",
