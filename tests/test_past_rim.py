@@ -132,3 +132,37 @@ def test_a_striker_past_its_target_opens_there(tmp_path_factory):
         distance = np.linalg.norm(X[gapside] - corner, axis=1)
         assert np.all(np.abs(state.gap[gapside] - distance) < 0.02)
         assert np.all(state.gap[gapside] > 0.03)
+
+
+@pytest.mark.mpi
+def test_written_gaps_lift_the_nodes_the_search_skin_kept():
+    """The skin re-searches only nodes that may have come near; the others keep the lift of
+    their last search. The written and measured gaps (contact_state) are those of a full
+    search: the hemispheres, where most of the upper hemisphere lies past the lower one's
+    rim and far from it."""
+    from fenics_contact.runner import scene_strategy
+    from fenics_contact.scene.build import build_problem
+    from fenics_contact.solvers.stepping import solve_load_path
+
+    scene = load_scene(ROOT / "scenes" / "two_hemispheres_3d_node_to_segment.toml")
+    problem = build_problem(scene)
+    solve_load_path(scene_strategy(scene, problem), 2)
+    contact = problem.contacts[0]
+    pair = contact.pair
+    comm = problem.comm
+    problem.u.x.array[:] *= 1.01  # a small motion: the skin keeps the far nodes
+    contact.refresh()
+    searched = comm.allreduce(pair.searched, op=MPI.SUM)
+    nodes = comm.allreduce(pair.striker_positions().shape[0], op=MPI.SUM)
+    kept_lifts = contact.surface.nodal(contact._gap_form)
+    written = contact.contact_state().gap  # this rank's owned nodes
+    pair._skin_current = None  # the next search searches every node
+    pair._searched_u = None
+    contact.refresh()
+    full = contact.surface.nodal(contact._gap_form)
+    h = float(contact.surface.h)
+    stale = comm.allreduce(float(np.abs(kept_lifts - full).max(initial=0.0)), op=MPI.MAX)
+    assert searched < nodes  # the skin kept some nodes
+    settled = comm.allreduce(float(np.abs(written - full).max(initial=0.0)), op=MPI.MAX)
+    assert settled <= 1e-12 * h
+    assert stale > 1e-6 * h  # without the settling they differ

@@ -45,6 +45,7 @@ from fenics_contact.model.search import (
     penetration_depth,
 )
 from fenics_contact.model.segments import node_blocks
+from fenics_contact.model.state import ContactState
 from fenics_contact.model.target_surface import REACH_FACETS, TargetSurface
 
 #: A node farther than this many facet sizes in front of its facet, with lam >= 0,
@@ -158,6 +159,10 @@ class DeformablePair:
         self._skin_current: np.ndarray | None = None
         #: Nodes the last search searched (owned and ghost).
         self.searched = 0
+        #: Which nodes the last search searched (the others kept their facet and lift).
+        self._fresh = np.ones(n_w, bool)
+        #: Whether some kept node's lift dates from an earlier search (:meth:`settle_lifts`).
+        self._stale_lifts = False
         self.w_prev: list[fem.Function] | None = None
         #: Incremented whenever some striker node changes facet (on any rank).
         self.version = 0
@@ -358,6 +363,7 @@ class DeformablePair:
                                   if k.startswith("kept_")}, self.u)
         self.assignment = np.asarray(state["assignment"], np.int64).copy()
         self.lift.x.array[:] = state["lift"]
+        self._stale_lifts = True  # the search that set them is not known here
         self.projection = (Projection(self.assignment.copy(), np.array(state["xi"]),
                                       np.array(state["distance"]), np.array(state["overshoot"]))
                            if bool(state["projection"]) else None)
@@ -387,8 +393,12 @@ class DeformablePair:
         facet size from it, gets the lift d - g: its gap becomes d, its distance
         from the target (> 0).
         """
-        lift = np.zeros(points.shape[0])
-        maybe = np.flatnonzero(proj.overshoot > 0.0)
+        fresh = self._fresh if self._fresh.shape[0] == points.shape[0] else np.ones(
+            points.shape[0], bool)
+        lift = self.lift.x.array.reshape(-1, self.gdim)[:, 0].copy()
+        lift[fresh] = 0.0  # a node the skin kept keeps its lift: it is open, far in front
+        self._stale_lifts = not fresh.all()
+        maybe = np.flatnonzero((proj.overshoot > 0.0) & fresh)
         if maybe.size and current.shape[0]:
             near = _closest(current, points[maybe], self._size)
             past = past_free_edge(points[maybe], current, self.target.free, size=self._size,
@@ -397,6 +407,21 @@ class DeformablePair:
             plane = self._plane_gaps(points[rows], current[proj.facet[rows]])
             lift[rows] = near.distance[past] - plane
         self.lift.x.array.reshape(-1, self.gdim)[:, 0] = lift
+
+    def settle_lifts(self) -> None:
+        """Lift every node past the rim to its present distance (for written gaps; collective).
+
+        A search lifts only the nodes it searched; the nodes its skin kept,
+        open and several facet sizes in front, keep the lift of their last
+        search, which moves their gap but not the answer. The gaps that are
+        written and measured are taken after this.
+        """
+        if not self.comm.allreduce(self._stale_lifts, op=MPI.LOR) or self.projection is None:
+            return
+        self._fresh = np.ones(self._fresh.shape[0], bool)
+        w_t = self.target_displacements()
+        self._lift_past_rim(self.striker_positions(), (self.X_vertices + w_t)[self.facet_vertex],
+                            self.projection)
 
     def _settled_search(self, points: np.ndarray, search) -> tuple[np.ndarray, Projection]:
         """Run ``search(current facets)`` until the kept facets settle ``points`` (collective).
@@ -448,6 +473,7 @@ class DeformablePair:
             proj.facet[todo], proj.xi[todo] = found.facet, found.xi
             proj.distance[todo], proj.overshoot[todo] = found.distance, found.overshoot
         self.searched = int(todo.sum())
+        self._fresh = todo
         slack = np.where(todo, proj.distance - SKIN * self._size, self._slack)
         self._slack, self._skin_points, self._skin_current = slack, points, current
         return proj
@@ -666,6 +692,12 @@ class NodeToSegmentContact(Contact):
     def refresh(self) -> bool:
         """Search and refill the target coefficients when u has changed."""
         return self.pair.refresh()
+
+    def contact_state(self) -> ContactState:
+        """The state (:meth:`Contact.contact_state`) with every lift of the present search."""
+        self.refresh()
+        self.pair.settle_lifts()
+        return super().contact_state()
 
     def search_state(self) -> dict[str, np.ndarray]:
         """The pair's search memory (:meth:`DeformablePair.search_state`)."""
