@@ -26,6 +26,7 @@ Run: ``python benchmarks/performance/newton_rates.py``.
 
 from __future__ import annotations
 
+import argparse
 import itertools
 import sys
 import tempfile
@@ -150,6 +151,7 @@ def run(name: str, path: Path) -> dict:
 
 def main() -> None:
     """Both pairs at both mesh sizes; the histories and the checks, JSON and markdown."""
+    argparse.ArgumentParser(description=__doc__.splitlines()[0]).parse_args()
     records, rows = {}, []
     with tempfile.TemporaryDirectory() as tmp:
         for h in (0.005, 0.01):
