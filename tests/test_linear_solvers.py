@@ -137,3 +137,23 @@ def test_solver_options_leave_with_their_kernel(release: str) -> None:
         del kernel
         gc.collect()
     assert [k for k in PETSc.Options().getAll() if k.startswith(prefix)] == []
+
+
+def test_a_failed_factorisation_does_not_poison_the_next_solve() -> None:
+    """A zero pivot fails one solve; the next, on a sound matrix, must factorise afresh.
+
+    MUMPS skips every numeric factorisation after one that failed, so a kept
+    solver would stop every cut-back attempt of the load step at its first
+    iteration (INFOG(1) = -3).
+    """
+    problem = cases.build(cases.block_indentation(3, depth=0.03, candidate_width=0.5), 1.0)
+    kernel = make_strategy("gnrm", problem, NEWTON).kernel
+    problem.set_load(0.5)
+    kernel.assemble_residual()
+    kernel._assemble_A()
+    assert kernel._linear_solve() and kernel.ksp.getConvergedReason() > 0
+    kernel.A.zeroRows([0], diag=0.0)  # a zero row: the factorisation fails
+    assert not kernel._linear_solve()
+    kernel._assemble_A()  # the sound matrix again
+    assert kernel._linear_solve() and kernel.ksp.getConvergedReason() > 0
+    assert np.all(np.isfinite(kernel.dx.getArray()))

@@ -102,13 +102,16 @@ class Contact:
         return self.friction_settings is not None
 
     # -- binding ------------------------------------------------------------------
-    def bind(self, solid, tags: mesh.MeshTags, ids: tuple[int, ...]) -> None:
+    def bind(self, solid, tags: mesh.MeshTags, ids: tuple[int, ...],
+             own_ids: tuple[int, ...] | None = None) -> None:
         """Build the surface, lam, r and the gap on ``solid`` (the problem calls this).
 
         Args:
             solid: the :class:`~.body.Solid` the surface belongs to.
             tags: the problem's facet tags.
             ids: the tag values of this contact's facets in ``tags``.
+            own_ids: those of ``ids`` that no other surface integral reads (facets
+                with this role only); default ``ids``.
         """
         if solid.degree > 1 and self.settings.quadrature == "nodal":
             raise ValueError(
@@ -124,6 +127,8 @@ class Contact:
         self.surface = ContactSurface(
             self.domain, self.facets, self.settings.quadrature, tags=tags, ids=ids
         )
+        #: The tag values whose facets carry this contact's integrals only.
+        self.own_ids = tuple(ids) if own_ids is None else tuple(own_ids)
         self.Q = self.surface.Q
         self.lam = fem.Function(self.Q, name="contact_pressure")
         self.r = fem.Constant(self.domain, default_scalar_type(1.0))

@@ -153,6 +153,15 @@ class DeformablePair:
         #: node is condensed (see :meth:`coupled`).
         self.multiplier = None
         self._coupled = np.ones(self.W.dofmap.index_map.size_local, bool)
+        #: The tag values that only the striker's contact integrals read (set by the
+        #: contact): :meth:`acting_facets` limits them; none, no limit.
+        self.limit_ids: tuple[int, ...] = ()
+        self._acting = la.vector(self.W.dofmap.index_map, 1)
+        sub_fdim = surface.submesh.topology.dim
+        sub_cells = surface.submesh.topology.index_map(sub_fdim)
+        #: The mesh facet of each submesh cell (owned and ghost).
+        self._cell_facet = np.asarray(surface.entity_map.sub_topology_to_topology(
+            np.arange(sub_cells.size_local + sub_cells.num_ghosts, dtype=np.int32), False))
         # the skin of the search (see _search): per node, how far it may still move
         self._slack = np.zeros(n_w)
         self._skin_points: np.ndarray | None = None
@@ -554,6 +563,26 @@ class DeformablePair:
         lam = self.multiplier()[:n]
         return (gap < COUPLING_GAP * self._size) | (lam < 0.0)
 
+    def acting_facets(self) -> list[tuple[tuple[int, ...], np.ndarray]]:
+        """Where the contact's terms can be nonzero: [(tag values, local mesh facets)].
+
+        The striker facets with a vertex that :meth:`coupled` keeps (collective:
+        ghost nodes take their owner's flag). On the others every node is open
+        at any r, and the contact's residual, its tangent and its coupling to
+        the target vanish there; the multiplier's own equation, lam / r = 0, is
+        the one term left (a solver keeps it everywhere). Empty (no limit) with
+        friction, where every node counts, or when no tag value is the
+        striker's alone (:attr:`limit_ids`).
+        """
+        if self.multiplier is None or not self.limit_ids:
+            return []
+        flags = self._acting
+        flags.array[: self.n_owned] = self._coupled
+        flags.scatter_forward()
+        cells = self.W.dofmap.list
+        acting = (flags.array[cells] > 0.5).any(axis=1)
+        return [(self.limit_ids, self._cell_facet[: cells.shape[0]][acting])]
+
     def _plane_gaps(self, points: np.ndarray, facets: np.ndarray) -> np.ndarray:
         """Signed distance of each point to the plane of its facet (facets: (n, nv, gdim))."""
         normal = self._normals(facets)
@@ -673,6 +702,7 @@ class NodeToSegmentContact(Contact):
                                         self.facets, self.neighbourhood)
         else:
             self.pair = DeformablePair(solid.V, solid.u, self.surface, self.target_facets)
+        self.pair.limit_ids = self.own_ids
         if not self.frictional:
             self.pair.multiplier = self._multiplier_at_nodes
         self.pair.refresh()

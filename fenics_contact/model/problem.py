@@ -51,7 +51,7 @@ from fenics_contact.model.residuals import (
     penalty_energy,
 )
 from fenics_contact.model.state import ContactState, ProblemState, combined_state
-from fenics_contact.model.tags import check_facet_indices, facet_roles
+from fenics_contact.model.tags import check_facet_indices, facet_roles, own_tag_values
 from fenics_contact.model.variational_system import Transfers, VariationalSystem, Work
 
 
@@ -86,8 +86,8 @@ class ContactProblem(FrictionalContacts):
                                     f"{type(c).__name__} {c.name!r}: {argument}")
         groups = [c.facets for c in self.contacts] + [t.facets for t in solid.tractions]
         self.facet_tags, ids = facet_roles(self.domain, groups)
-        for contact, tag_ids in zip(self.contacts, ids, strict=False):
-            contact.bind(solid, self.facet_tags, tag_ids)
+        for contact, tag_ids, own in zip(self.contacts, ids, own_tag_values(ids), strict=False):
+            contact.bind(solid, self.facet_tags, tag_ids, own_ids=own)
         for contact in self.contacts:  # the overlaps an interference fit starts in
             contact.capture_interference()
             contact.ramp_interference(0.0)

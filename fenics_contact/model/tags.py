@@ -60,3 +60,17 @@ def facet_roles(
     tags = mesh.meshtags(domain, fdim, used.astype(np.int32), values)
     ids = [tuple(value_of[c] for c in combos if c >> i & 1) for i in range(len(groups))]
     return tags, ids
+
+
+def own_tag_values(ids: Sequence[tuple[int, ...]]) -> list[tuple[int, ...]]:
+    """Per role, its tag values that no other role reads (facets with that role alone).
+
+    ``ids``: each role's tag values, as :func:`facet_roles` gives them. A
+    solver may integrate a role's terms over fewer of these facets without
+    touching another role's integrals.
+    """
+    out = []
+    for i, values in enumerate(ids):
+        others = {t for j, group in enumerate(ids) if j != i for t in group}
+        out.append(tuple(t for t in values if t not in others))
+    return out

@@ -94,6 +94,11 @@ class Transfers:
                 out += [None] * len(items)
         return out
 
+    def acting_facets(self) -> list[tuple[tuple[int, ...], np.ndarray]]:
+        """Every contact's limits of its integrals (see pairs' ``acting_facets``)."""
+        return [limit for t in self.transfers if hasattr(t, "acting_facets")
+                for limit in t.acting_facets()]
+
     def curvature(self, residual_of) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The second-derivative terms of the contacts whose extras are not linear in u."""
         parts = [t.curvature(residual_of) for t in self.transfers if hasattr(t, "curvature")]

@@ -22,6 +22,13 @@ Dirichlet rows and columns are set after the product
 x - x_D and the columns are eliminated with PETSc's ``zeroRowsColumns``,
 which also lifts the right-hand side. The residual norm is that of the
 condensed residual with those rows, the measure of :class:`NewtonKernel`.
+
+A frictionless node-to-segment pair acts only near its coupled nodes; the
+kernel integrates the pair's terms there (:mod:`.restricted_forms`, the
+transfer's ``acting_facets``), except the multipliers' own blocks, which
+hold lam / r = 0 at every open node. J_ext is assembled over every facet
+once first, so that its PETSc pattern, and with it the symbolic product,
+never changes.
 """
 
 from __future__ import annotations
@@ -41,6 +48,7 @@ from fenics_contact.model.form_batches import form_together
 from fenics_contact.model.problem import VariationalSystem
 from fenics_contact.solvers.linear import LinearSolverSettings
 from fenics_contact.solvers.newton import NewtonKernel
+from fenics_contact.solvers.restricted_forms import FacetLimit, restrict
 from fenics_contact.solvers.timing import stopwatch
 
 _prefix_counter = itertools.count()
@@ -98,6 +106,13 @@ class CondensedKernel(NewtonKernel):
                 [list(system.residuals), blocks], entity_maps=system.entity_maps,
                 jit_options=system.jit_options)
             self.A_ext = fem_petsc.create_matrix(self.J_ext, kind="mpi")
+            # every facet's entries, before any limited assembly: PETSc's pattern is the
+            # entries an assembly set, and P^T A P reuses its product only on a fixed one
+            fem_petsc.assemble_matrix(self.A_ext, self.J_ext, bcs=[], diag=1.0)
+            self.A_ext.assemble()
+            self.A_ext.setOption(PETSc.Mat.Option.NEW_NONZERO_LOCATION_ERR, True)
+            self._F_all, self._J_all = self.F_ext, self.J_ext
+            self._limits: list[FacetLimit] = []
             self.ext_spaces = [f.function_space for f in ext]
             self.b_ext = fem_petsc.create_vector(self.ext_spaces, kind="mpi")
             self._work_vectors()
@@ -269,12 +284,43 @@ class CondensedKernel(NewtonKernel):
         """Search and refill the target coefficients; new P when an assignment changed."""
         with stopwatch(self.timings, "search_s"):
             self.transfer.refresh()
+        with stopwatch(self.timings, "transfer_s"):
+            self._limit_forms()
         if self._P_version != self.transfer.version:
             with stopwatch(self.timings, "transfer_s"):
                 if self._build_P() and self.A is not None:
                     self.A.destroy()
                     self.A = None
                     self.rebuilds = getattr(self, "rebuilds", 0) + 1
+
+    def _limit_forms(self) -> None:
+        """Integrate the pairs' terms only where they can act (``acting_facets``).
+
+        Every block keeps its compiled kernels; the blocks of u and of the
+        extras, residual and tangent, are rebuilt over the acting facets when
+        they change (collective). A multiplier's own blocks keep every facet:
+        lam / r = 0 is the equation of an open node.
+        """
+        acting = (self.transfer.acting_facets() if hasattr(self.transfer, "acting_facets")
+                  else [])
+        limits = [FacetLimit(ids, facets) for ids, facets in acting]
+        same = len(limits) == len(self._limits) and all(
+            a.same_as(b) for a, b in zip(limits, self._limits, strict=True))
+        if self._comm.allreduce(same, op=MPI.LAND):
+            return
+        self._limits = limits
+        maps = self.system.entity_maps
+        n = len(self.unknowns)
+
+        def own(i: int) -> bool:  # a multiplier of the unknowns
+            return 1 <= i < n
+
+        def limited(form: fem.Form | None, whole: bool) -> fem.Form | None:
+            return form if form is None or whole or not limits else restrict(form, limits, maps)
+
+        self.F_ext = [limited(f, own(i)) for i, f in enumerate(self._F_all)]
+        self.J_ext = [[limited(f, own(i) and own(j)) for j, f in enumerate(row)]
+                      for i, row in enumerate(self._J_all)]
 
     # -- assembly ------------------------------------------------------------------
     def _assemble_condensed_jacobian(self) -> None:

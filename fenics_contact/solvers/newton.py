@@ -302,8 +302,10 @@ class NewtonKernel:
             # A solve that stops with an error (e.g. a singular factorisation) leaves
             # b locked read-only: the next assembly into it would fail ("error code 73").
             self.b = self.b.duplicate()
-            if self.lag is not None:
-                self.lag.reset()
+            self._solver_afresh()
+            return False
+        if self.ksp.getPC().getFailedReason() != 0:  # e.g. a zero pivot
+            self._solver_afresh()
             return False
         self.linear_solves += 1
         t.linear_solves += 1
@@ -314,6 +316,16 @@ class NewtonKernel:
             reduction = self.ksp.getResidualNorm() / rhs if rhs > 0 else 0.0
             self.lag.record(self.ksp.getIterationNumber(), reduction, build)
         return True
+
+    def _solver_afresh(self) -> None:
+        """A new linear solver after a failed one (same settings, no kept state).
+
+        A factorisation that failed leaves its solver unusable: MUMPS skips
+        every later numeric factorisation after one that failed, and the next
+        solve stops with INFOG(1) = -3, so every cut-back attempt of the load
+        step would fail at its first iteration.
+        """
+        self.set_linear_solver(self.linear)
 
     def destroy(self) -> None:
         """Free the PETSc objects and remove the solver's options from the database."""
