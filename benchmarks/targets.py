@@ -194,7 +194,9 @@ def _two_body(ranks: int) -> Callable:
         record = _two_body_record(bench, ranks)
         ratio = record["cost_ratio_per_iteration"]
         rounds = ", ".join(f"{r:.2f}" for r in record["cost_ratio_per_round"])
-        return f"{ratio:.2f}x (rounds {rounds})", ratio <= 1.3
+        per_dof = record.get("cost_ratio_per_iteration_and_dof")
+        sized = f"; {per_dof:.2f}x per DOF" if per_dof is not None else ""
+        return f"{ratio:.2f}x (rounds {rounds}{sized})", ratio <= 1.3
 
     return measure
 

@@ -138,3 +138,17 @@ def test_pair_integrated_only_where_it_can_act(pressed_cylinders) -> None:
     assert kernel.F_ext is limited[0]  # the limits held: the whole forms were used above
     np.testing.assert_allclose(b_limited, b_all, rtol=0, atol=1e-13 * np.abs(b_all).max())
     np.testing.assert_allclose(A_limited, A_all, rtol=0, atol=1e-13 * np.abs(A_all).max())
+
+
+def test_a_step_sets_in_contact_only_nodes_the_pair_couples(pressed_cylinders) -> None:
+    """The exact contact set may close only nodes whose terms the kernel integrates."""
+    problem, _, pair = pressed_cylinders
+    contact = next(c for c in problem.contacts if getattr(c, "pair", None) is pair)
+    gaps = contact.surface.nodal(contact._gap_form)
+    allowed = contact.may_close(gaps)
+    assert allowed.shape == gaps.shape
+    assert 0 < allowed.sum() < allowed.size
+    lam_of_w = contact._lam_of_w[: pair.n_owned]
+    np.testing.assert_array_equal(allowed[lam_of_w], pair._coupled)
+    # the open nodes left out are more than a facet size away; those near all count
+    assert np.all(allowed[gaps < 0.5 * pair._size])

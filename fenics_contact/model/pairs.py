@@ -718,6 +718,18 @@ class NodeToSegmentContact(Contact):
             self._lam_of_w = index
         return self.lam.x.array[self._lam_of_w]
 
+    def may_close(self, gaps: np.ndarray) -> np.ndarray:
+        """The nodes the pair couples (:meth:`DeformablePair.coupled`), owned, in lam's order.
+
+        Elsewhere the solver holds neither the node's coupling to the target
+        nor its terms (they are zero while it is open), so a Newton step must
+        not set it in contact.
+        """
+        self._multiplier_at_nodes()  # the W -> lam map
+        flags = np.zeros(self.lam.x.array.size, bool)
+        flags[self._lam_of_w[: self.pair.n_owned]] = self.pair._coupled
+        return flags[: gaps.size]
+
     # -- search ---------------------------------------------------------------------
     def refresh(self) -> bool:
         """Search and refill the target coefficients when u has changed."""
