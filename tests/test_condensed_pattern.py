@@ -5,7 +5,8 @@ converged state: about a third of the striker nodes are open far from the
 other cylinder, so the selection P leaves them out (their residual and
 tangent do not depend on the target); P also holds explicit zeros for the
 vertices of the facets around each node's facet, so a move to one of them
-changes values only.
+changes values only. The pair's terms are integrated only over the facets
+of coupled nodes, exactly, and a Newton step closes only such nodes.
 """
 
 from __future__ import annotations
@@ -64,6 +65,52 @@ def test_open_nodes_are_left_out_exactly(solved) -> None:
         pair.version += 1
     np.testing.assert_allclose(b_pruned, b_all, rtol=0, atol=1e-14 * np.abs(b_all).max())
     np.testing.assert_allclose(A_pruned, A_all, rtol=0, atol=1e-12 * np.abs(A_all).max())
+
+
+def test_pair_integrated_only_where_it_can_act(solved) -> None:
+    problem, kernel, pair = solved
+    kernel._limit_forms()  # the pair's own limit (a test above condensed every node)
+    (limit,) = kernel._limits
+    striker = pair.surface.facets
+    assert 0 < limit.facets.size < striker.size  # 28 of 38
+    contact = next(c for c in problem.contacts if getattr(c, "pair", None) is pair)
+    pressed = pair.multiplier() < 0.0  # serial: every node is owned
+    assert pressed.sum() >= 3
+    cells = pair.W.dofmap.list
+    touching = pair._cell_facet[: cells.shape[0]][pressed[cells].any(axis=1)]
+    assert np.isin(touching, limit.facets).all()
+    assert set(limit.ids) == set(contact.own_ids)
+
+    # the extended matrix holds every facet's entries (P^T A P reuses its symbolic
+    # product: entries a later, wider assembly added would be left out of it)
+    used = kernel.A_ext.getInfo()["nz_used"]
+    kernel._assemble_ext_jacobian(kernel._J_all)  # every facet: no entry may be new
+    assert kernel.A_ext.getInfo()["nz_used"] == used
+
+    b_limited, A_limited = _condensed(kernel)
+    limited = kernel.F_ext, kernel.J_ext
+    try:
+        kernel.F_ext, kernel.J_ext = kernel._F_all, kernel._J_all  # every striker facet
+        b_all, A_all = _condensed(kernel)
+    finally:
+        kernel.F_ext, kernel.J_ext = limited
+    assert kernel.F_ext is limited[0]  # the limits held: the whole forms were used above
+    np.testing.assert_allclose(b_limited, b_all, rtol=0, atol=1e-13 * np.abs(b_all).max())
+    np.testing.assert_allclose(A_limited, A_all, rtol=0, atol=1e-13 * np.abs(A_all).max())
+
+
+def test_a_step_sets_in_contact_only_nodes_the_pair_couples(solved) -> None:
+    """The exact contact set may close only nodes whose terms the kernel integrates."""
+    problem, _, pair = solved
+    contact = next(c for c in problem.contacts if getattr(c, "pair", None) is pair)
+    gaps = contact.surface.nodal(contact._gap_form)
+    allowed = contact.may_close(gaps)
+    assert allowed.shape == gaps.shape
+    assert 0 < allowed.sum() < allowed.size
+    lam_of_w = contact._lam_of_w[: pair.n_owned]
+    np.testing.assert_array_equal(allowed[lam_of_w], pair._coupled)
+    # the open nodes left out are more than a facet size away; those near all count
+    assert np.all(allowed[gaps < 0.5 * pair._size])
 
 
 def test_tangent_with_open_nodes_left_out(solved) -> None:
