@@ -81,10 +81,21 @@ def _nonempty_blocks(residuals: list[ufl.Form], unknowns: list) -> list[list[ufl
     return out
 
 
-def _part(form: ufl.Form, *, volume: bool) -> ufl.Form | None:
-    """The cell integrals of ``form`` (volume) or the others; None when there are none."""
-    kept = [i for i in form.integrals() if (i.integral_type() == "cell") == volume]
+def _part(form: ufl.Form, bodies: ufl.Mesh, *, volume: bool) -> ufl.Form | None:
+    """The bodies' cell integrals of ``form`` (volume) or the others; None when none.
+
+    A cell integral over another mesh (a contact submesh) is a surface term.
+    """
+    kept = [i for i in form.integrals()
+            if (i.integral_type() == "cell" and i.ufl_domain() == bodies) == volume]
     return ufl.Form(kept) if kept else None
+
+
+def _every_row_and_column(blocks: list[list[ufl.Form | None]]) -> bool:
+    """Whether every row and every column of a block structure holds a block."""
+    rows = all(any(f is not None for f in row) for row in blocks)
+    columns = all(any(row[j] is not None for row in blocks) for j in range(len(blocks[0])))
+    return rows and columns
 
 
 def _owned(space: fem.FunctionSpace) -> int:
@@ -114,9 +125,13 @@ class CondensedKernel(NewtonKernel):
             # the bodies' volume terms and the surface terms in forms of their own: in one
             # form with the pairs' coefficients the volume kernels assembled 3x slower
             residuals = list(system.residuals)
-            volume = [_part(F, volume=True) for F in residuals]
-            surface = [_part(F, volume=False) for F in residuals]
+            bodies = self.unknowns[0].function_space.mesh.ufl_domain()
+            volume = [_part(F, bodies, volume=True) for F in residuals]
+            surface = [_part(F, bodies, volume=False) for F in residuals]
             surface_blocks = _nonempty_blocks(surface, ext)
+            if not _every_row_and_column(surface_blocks):  # DOLFINx's block assembly needs it
+                volume, surface = [None] * len(residuals), residuals
+                surface_blocks = _nonempty_blocks(surface, ext)
             volume_blocks = _nonempty_blocks(volume, ext)
             self.F_ext, self.J_ext, self.F_vol, self.J_vol = form_together(
                 [surface, surface_blocks, volume, volume_blocks],
